@@ -1,0 +1,1 @@
+//! rcs-codegen: placeholder until the code-generation issue lands.

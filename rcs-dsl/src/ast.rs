@@ -1,0 +1,279 @@
+//! The syntax tree: what the parser (`parser.rs`) builds from pest's pairs
+//! and what `lower` resolves into the IR. Nothing here is checked beyond
+//! syntax; every node keeps the span it came from.
+
+use crate::lint::LintOverride;
+use crate::source::Span;
+
+/// A name as written, with where it was written.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Name {
+    pub text: String,
+    pub span: Span,
+}
+
+/// One parsed `.rcs` file.
+#[derive(Clone, Debug, Default)]
+pub struct File {
+    pub items: Vec<Item>,
+}
+
+/// `#[allow(...)]`-style attributes and `///` docs before an item or plan.
+#[derive(Clone, Debug, Default)]
+pub struct Outer {
+    pub docs: Vec<String>,
+    pub lints: Vec<(LintOverride, Span)>,
+}
+
+#[derive(Clone, Debug)]
+pub enum Item {
+    Enum(EnumDef),
+    Buffer(BufferDef),
+    Controller(ControllerDef),
+}
+
+#[derive(Clone, Debug)]
+pub struct EnumDef {
+    pub outer: Outer,
+    pub name: Name,
+    pub variants: Vec<(Vec<String>, Name)>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug)]
+pub struct BufferDef {
+    pub outer: Outer,
+    pub name: Name,
+    pub fields: Vec<Field>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug)]
+pub struct Field {
+    pub docs: Vec<String>,
+    pub name: Name,
+    pub ty: TypeExpr,
+}
+
+#[derive(Clone, Debug)]
+pub enum TypeExpr {
+    Named(Name),
+    Array {
+        elem: Box<TypeExpr>,
+        len: u64,
+        span: Span,
+    },
+}
+
+impl TypeExpr {
+    pub fn span(&self) -> Span {
+        match self {
+            TypeExpr::Named(n) => n.span,
+            TypeExpr::Array { span, .. } => *span,
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct ControllerDef {
+    pub outer: Outer,
+    pub name: Name,
+    pub title: Option<String>,
+    pub entries: Vec<Entry>,
+    pub span: Span,
+}
+
+/// One entry of a controller body, with its docs.
+#[derive(Clone, Debug)]
+pub struct Entry {
+    pub outer: Outer,
+    pub kind: EntryKind,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug)]
+pub enum EntryKind {
+    Level(u64, Span),
+    /// The list's names and the span of the whole list.
+    Subordinates(Vec<Name>),
+    Reads(Name, Name),
+    Writes(Name, Name),
+    Command(Name, Vec<Param>),
+    Status(Vec<Name>),
+    Error(Vec<Name>),
+    Var {
+        name: Name,
+        ty: TypeExpr,
+        init: Option<Expr>,
+    },
+    Hook {
+        name: Name,
+        params: Vec<Param>,
+        ret: Option<TypeExpr>,
+    },
+    Plan(PlanDef),
+}
+
+#[derive(Clone, Debug)]
+pub struct Param {
+    pub name: Name,
+    pub ty: TypeExpr,
+}
+
+#[derive(Clone, Debug)]
+pub struct PlanDef {
+    pub verb: Name,
+    /// `plan VERB` — the header, where plan-wide diagnostics point.
+    pub header: Span,
+    pub rows: Vec<Row>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Row {
+    pub docs: Vec<String>,
+    /// `EN` as written, with its number.
+    pub label: Option<(u64, Span)>,
+    pub from: From,
+    /// `None` for an `otherwise` row.
+    pub cond: Option<Expr>,
+    /// The span of `otherwise` or of the condition.
+    pub cond_span: Span,
+    pub target: Target,
+    pub jobs: Vec<Job>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug)]
+pub enum From {
+    /// `*` or `*N`.
+    DontCare(Option<u64>, Span),
+    State(Name),
+    /// An `otherwise` row written without `*`.
+    Implicit,
+}
+
+#[derive(Clone, Debug)]
+pub enum Target {
+    Same(Span),
+    Error(Option<Name>, Span),
+    /// A state name, `Done` included.
+    State(Name),
+}
+
+impl Target {
+    pub fn span(&self) -> Span {
+        match self {
+            Target::Same(s) | Target::Error(_, s) => *s,
+            Target::State(n) => n.span,
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub enum Job {
+    Send {
+        sub: Name,
+        verb: Name,
+        args: Vec<(Name, Expr)>,
+        span: Span,
+    },
+    Report(Name, Span),
+    Assign {
+        place: Expr,
+        op: AssignOp,
+        value: Expr,
+        span: Span,
+    },
+    Call(Expr),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AssignOp {
+    Set,
+    Add,
+    Sub,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BinOp {
+    Or,
+    And,
+    Eq,
+    Ne,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Rem,
+}
+
+impl BinOp {
+    pub fn symbol(self) -> &'static str {
+        match self {
+            BinOp::Or => "||",
+            BinOp::And => "&&",
+            BinOp::Eq => "==",
+            BinOp::Ne => "!=",
+            BinOp::Lt => "<",
+            BinOp::Le => "<=",
+            BinOp::Gt => ">",
+            BinOp::Ge => ">=",
+            BinOp::Add => "+",
+            BinOp::Sub => "-",
+            BinOp::Mul => "*",
+            BinOp::Div => "/",
+            BinOp::Rem => "%",
+        }
+    }
+
+    /// Binding strength: larger binds tighter. Used when printing.
+    pub fn precedence(self) -> u8 {
+        match self {
+            BinOp::Or => 1,
+            BinOp::And => 2,
+            BinOp::Eq | BinOp::Ne | BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge => 3,
+            BinOp::Add | BinOp::Sub => 4,
+            BinOp::Mul | BinOp::Div | BinOp::Rem => 5,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum UnOp {
+    Not,
+    Neg,
+}
+
+#[derive(Clone, Debug)]
+pub struct Expr {
+    pub kind: ExprKind,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug)]
+pub enum ExprKind {
+    Int(u128),
+    Float(f64),
+    Bool(bool),
+    NewCommand,
+    StateCycles,
+    PlanCycles,
+    /// `cmd.P`
+    CmdParam(Name),
+    /// A bare name or `Type::Variant`.
+    Path(Option<Name>, Name),
+    Call(Name, Vec<Expr>),
+    Field(Box<Expr>, Name),
+    Index(Box<Expr>, Box<Expr>),
+    Unary(UnOp, Box<Expr>),
+    Binary(BinOp, Box<Expr>, Box<Expr>),
+    Cast(Box<Expr>, Name),
+    Paren(Box<Expr>),
+}

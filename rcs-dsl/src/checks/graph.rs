@@ -1,0 +1,140 @@
+//! The plan graph (states as nodes, rows as edges) on petgraph, and the
+//! checks that walk it: `unreachable_state`, `dead_end_state`, `no_done`.
+//!
+//! The graph starts at `S0`. A row with `new_command` as a top-level
+//! conjunct is an edge from `S0` only; any other don't-care row (and
+//! `otherwise`) is an edge from every state; `same` never leaves a state.
+//! Rows that can never match (see `plan::never_matches`) add no edge.
+
+use super::Sink;
+use crate::diagnostic::Diagnostic;
+use crate::ir::{Controller, From, Ir, Plan, StateId, Target};
+use crate::lint::Lint;
+use petgraph::graph::{DiGraph, NodeIndex};
+use petgraph::visit::{Bfs, Walker};
+
+/// What the graph says about one plan.
+pub(crate) struct Analysis {
+    /// Per state: reachable from `S0`.
+    pub reachable: Vec<bool>,
+    /// Per state: some row leads from it to another node.
+    pub leaves: Vec<bool>,
+    /// `Done` or `Error` is reachable from `S0`.
+    pub ends: bool,
+    /// Per row: judged unable to match by its own `from` and condition.
+    pub never_matches: Vec<bool>,
+}
+
+pub(crate) fn analyse(p: &Plan) -> Analysis {
+    let n = p.states.len();
+    let mut g: DiGraph<(), ()> = DiGraph::with_capacity(n + 2, p.rows.len() * 2);
+    for _ in 0..n + 2 {
+        g.add_node(());
+    }
+    let (done, error) = (NodeIndex::new(n), NodeIndex::new(n + 1));
+    let never_matches: Vec<bool> = p.rows.iter().map(super::plan::never_matches).collect();
+    for (row, never) in p.rows.iter().zip(&never_matches) {
+        if *never {
+            continue;
+        }
+        let to = match row.to {
+            Target::Same => continue,
+            Target::State(s) => NodeIndex::new(s.index()),
+            Target::Done => done,
+            Target::Error(_) => error,
+        };
+        let froms: Vec<usize> = match row.from {
+            _ if row.is_entry => vec![StateId::S0.index()],
+            From::State(s) => vec![s.index()],
+            From::DontCare(_) => (0..n).collect(),
+        };
+        for f in froms {
+            if NodeIndex::new(f) != to {
+                g.add_edge(NodeIndex::new(f), to, ());
+            }
+        }
+    }
+    let mut reachable = vec![false; n + 2];
+    for node in Bfs::new(&g, NodeIndex::new(0)).iter(&g) {
+        reachable[node.index()] = true;
+    }
+    let ends = reachable[n] || reachable[n + 1];
+    let leaves = (0..n)
+        .map(|s| g.neighbors(NodeIndex::new(s)).next().is_some())
+        .collect();
+    reachable.truncate(n);
+    Analysis {
+        reachable,
+        leaves,
+        ends,
+        never_matches,
+    }
+}
+
+pub(crate) fn check_unreachable_states(c: &Controller, p: &Plan, a: &Analysis, sink: &mut Sink) {
+    for (i, s) in p.states.iter().enumerate().skip(1) {
+        if a.reachable[i] {
+            continue;
+        }
+        let Some(span) = s.span else { continue };
+        sink.lint(
+            Some(c),
+            Some(p),
+            Diagnostic::lint(
+                Lint::UnreachableState,
+                format!(
+                    "state `{}` of plan `{}` is never reached",
+                    s.name,
+                    c.commands[p.verb.index()].name
+                ),
+                span,
+                "no path from the entry leads here",
+            )
+            .with_help("add a row whose target is this state, or remove its rows"),
+        );
+    }
+}
+
+pub(crate) fn check_dead_ends(c: &Controller, p: &Plan, a: &Analysis, sink: &mut Sink) {
+    let has_entry = p.rows.iter().any(|r| r.is_entry);
+    for (i, s) in p.states.iter().enumerate() {
+        if a.leaves[i] || !a.reachable[i] || (i == 0 && !has_entry) {
+            continue;
+        }
+        let span = s.span.unwrap_or(p.header);
+        sink.lint(
+            Some(c),
+            Some(p),
+            Diagnostic::lint(
+                Lint::DeadEndState,
+                format!("state `{}` of plan `{}` has no way out", s.name, c.commands[p.verb.index()].name),
+                span,
+                "no row leaves this state",
+            )
+            .with_note("only a new command can end the plan here")
+            .with_help("add a row from this state to another state, `Done` or `Error(…)`; a continuous plan can `#[allow(dead_end_state)]`"),
+        );
+    }
+}
+
+pub(crate) fn check_no_done(ir: &Ir, c: &Controller, p: &Plan, a: &Analysis, sink: &mut Sink) {
+    if a.ends {
+        return;
+    }
+    let _ = ir;
+    sink.lint(
+        Some(c),
+        Some(p),
+        Diagnostic::lint(
+            Lint::NoDone,
+            format!(
+                "plan `{}` of `{}` never reaches `Done` or `Error`",
+                c.commands[p.verb.index()].name,
+                c.name
+            ),
+            p.header,
+            "this plan never ends",
+        )
+        .with_help("the supervisor never sees DONE; a continuous plan can `#[allow(no_done)]`"),
+    );
+}

@@ -1,0 +1,73 @@
+//! Stage 3: checks over the IR. Each rule is its own `check_*` function that
+//! reads the IR and pushes findings into one [`Sink`]; none changes the IR.
+//! Hard errors go in as they are; lints pass through the lint levels in
+//! force at their place (manifest, flags, then attributes).
+
+mod graph;
+mod hierarchy;
+mod plan;
+mod usage;
+
+use crate::diagnostic::{Diagnostic, Diagnostics};
+use crate::ir::{Controller, Ir, Plan};
+use crate::lint::{Lint, LintLevels};
+use crate::source::SourceMap;
+
+/// Where findings go: errors straight through, lints through their levels.
+pub(crate) struct Sink<'a> {
+    levels: &'a LintLevels,
+    diags: &'a mut Diagnostics,
+}
+
+impl Sink<'_> {
+    pub fn error(&mut self, d: Diagnostic) {
+        self.diags.push(d);
+    }
+
+    /// A lint finding inside `ctrl` (and `plan`, if any); attributes there apply.
+    pub fn lint(&mut self, ctrl: Option<&Controller>, plan: Option<&Plan>, d: Diagnostic) {
+        let crate::diagnostic::Code::Lint(lint) = d.code else {
+            unreachable!("Sink::lint takes lint findings only")
+        };
+        let mut scopes: Vec<&[(Lint, crate::lint::Level)]> = Vec::new();
+        if let Some(c) = ctrl {
+            scopes.push(&c.lints);
+        }
+        if let Some(p) = plan {
+            scopes.push(&p.lints);
+        }
+        let level = self.levels.at(lint, &scopes);
+        let is_default =
+            level == lint.default_level() && self.levels.get(lint) == lint.default_level();
+        if let Some(d) = d.at_level(level, is_default) {
+            self.diags.push(d);
+        }
+    }
+}
+
+/// Run every check over a lowered plan set.
+pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagnostics) {
+    let start = diags.len();
+    let mut sink = Sink { levels, diags };
+    plan::check_missing_plans(ir, &mut sink);
+    for c in &ir.controllers {
+        for p in &c.plans {
+            plan::check_row_numbers(c, p, &mut sink);
+            plan::check_otherwise(p, &mut sink);
+            plan::check_entry(p, &mut sink);
+            plan::check_double_commands(ir, p, &mut sink);
+            plan::check_rule_of_ten(ir, c, p, &mut sink);
+            let analysis = graph::analyse(p);
+            plan::check_unreachable_rows(p, &analysis, &mut sink);
+            plan::check_shadowed_rows(c, p, &analysis, &mut sink);
+            graph::check_unreachable_states(c, p, &analysis, &mut sink);
+            graph::check_dead_ends(c, p, &analysis, &mut sink);
+            graph::check_no_done(ir, c, p, &analysis, &mut sink);
+        }
+    }
+    hierarchy::check_span_of_control(ir, &mut sink);
+    hierarchy::check_level_order(ir, &mut sink);
+    usage::check_float_equality(ir, &mut sink);
+    usage::check_unused(ir, &mut sink);
+    diags.sort_from(start, sources);
+}

@@ -1,0 +1,341 @@
+//! Row-level checks of one plan: numbering, `otherwise`, entry rows, rows
+//! that never match or are always taken first, double commands, the rule of
+//! ten, and commands without a plan.
+
+use super::graph::Analysis;
+use super::Sink;
+use crate::diagnostic::{Code, Diagnostic};
+use crate::ir::{Condition, Controller, Expr, ExprKind, From, Ir, Job, Plan, Row, StateId};
+use crate::lint::Lint;
+
+fn verb<'a>(c: &'a Controller, p: &Plan) -> &'a str {
+    &c.commands[p.verb.index()].name
+}
+
+pub(crate) fn check_missing_plans(ir: &Ir, sink: &mut Sink) {
+    for c in &ir.controllers {
+        for cmd in c.commands.iter().filter(|cmd| cmd.plan.is_none()) {
+            sink.error(
+                Diagnostic::error(
+                    Code::MissingPlan,
+                    format!("command `{}` of `{}` has no plan", cmd.name, c.name),
+                    cmd.span,
+                    "declared here without a plan",
+                )
+                .with_help(format!(
+                    "every command needs a plan (§5.3.2.1): `plan {} {{ *0 when new_command -> … }}`",
+                    cmd.name
+                )),
+            );
+        }
+    }
+}
+
+pub(crate) fn check_row_numbers(c: &Controller, p: &Plan, sink: &mut Sink) {
+    for r in &p.rows {
+        if let (Some(n), Some(span)) = (r.label, r.label_span) {
+            if n != r.position {
+                sink.error(
+                    Diagnostic::error(
+                        Code::RowNumber,
+                        format!(
+                            "row label `E{n}` does not match its position {} in plan `{}`",
+                            r.position,
+                            verb(c, p)
+                        ),
+                        span,
+                        format!("this is row {}", r.position),
+                    )
+                    .with_note("row numbers are precedence positions, counted from 0")
+                    .with_help(format!("write `E{}`, or drop the label", r.position)),
+                );
+            }
+        }
+        if let From::DontCare(Some(n)) = r.from {
+            if n != r.position {
+                sink.error(
+                    Diagnostic::error(
+                        Code::RowNumber,
+                        format!(
+                            "don't-care `*{n}` does not match its position {} in plan `{}`",
+                            r.position,
+                            verb(c, p)
+                        ),
+                        r.from_span,
+                        format!("this is row {}", r.position),
+                    )
+                    .with_note("row numbers are precedence positions, counted from 0")
+                    .with_help(format!("write `*{}`, or a plain `*`", r.position)),
+                );
+            }
+        }
+    }
+}
+
+pub(crate) fn check_otherwise(p: &Plan, sink: &mut Sink) {
+    let mut first: Option<&Row> = None;
+    for r in p.rows.iter().filter(|r| r.is_otherwise()) {
+        if let Some(f) = first {
+            sink.error(
+                Diagnostic::error(
+                    Code::OtherwiseNotLast,
+                    "a plan has at most one `otherwise` row",
+                    r.cond_span,
+                    "second `otherwise`",
+                )
+                .with_secondary(f.cond_span, "first `otherwise` here")
+                .with_help("merge the two rows"),
+            );
+            continue;
+        }
+        first = Some(r);
+        if r.position as usize + 1 != p.rows.len() {
+            sink.error(
+                Diagnostic::error(
+                    Code::OtherwiseNotLast,
+                    "`otherwise` must be the last row of its plan",
+                    r.cond_span,
+                    "rows follow it",
+                )
+                .with_secondary(
+                    p.rows[r.position as usize + 1].span,
+                    "this row comes after `otherwise`",
+                )
+                .with_help("move the `otherwise` row to the end"),
+            );
+        }
+    }
+}
+
+pub(crate) fn check_entry(p: &Plan, sink: &mut Sink) {
+    if !p.rows.iter().any(|r| r.is_entry) {
+        sink.error(
+            Diagnostic::error(
+                Code::EntryMissing,
+                "no row of this plan handles a new command",
+                p.header,
+                "no row tests `new_command`",
+            )
+            .with_note(
+                "a plan starts in S0 on the cycle its command arrives (§A `check_if_new_command`)",
+            )
+            .with_help("make the first row an entry: `*0 when new_command -> S1 { … }`"),
+        );
+        return;
+    }
+    let mut first_ordinary: Option<&Row> = None;
+    for r in &p.rows {
+        if r.is_otherwise() {
+            continue;
+        }
+        if !r.is_entry {
+            first_ordinary.get_or_insert(r);
+        } else if let Some(o) = first_ordinary {
+            sink.error(
+                Diagnostic::error(
+                    Code::EntryNotFirst,
+                    "a row testing `new_command` stands after a row that does not",
+                    r.cond_span,
+                    "entry row",
+                )
+                .with_secondary(o.span, "this ordinary row comes first")
+                .with_help("move the rows that test `new_command` to the top of the plan"),
+            );
+        }
+    }
+}
+
+/// Whether a row can never match, judged by its own `from` and condition.
+pub(crate) fn never_matches(r: &Row) -> bool {
+    let from_later_state = matches!(r.from, From::State(s) if s != StateId::S0);
+    match &r.cond {
+        Condition::Otherwise => false,
+        Condition::When(c) => (r.is_entry && from_later_state) || has_false_conjunct(c),
+    }
+}
+
+fn has_false_conjunct(e: &Expr) -> bool {
+    match &e.kind {
+        ExprKind::Bool(false) => true,
+        ExprKind::Binary(crate::ast::BinOp::And, l, r) => {
+            has_false_conjunct(l) || has_false_conjunct(r)
+        }
+        _ => false,
+    }
+}
+
+fn from_reachable(r: &Row, a: &Analysis) -> bool {
+    match r.from {
+        From::State(s) => a.reachable[s.index()],
+        From::DontCare(_) => true,
+    }
+}
+
+pub(crate) fn check_unreachable_rows(p: &Plan, a: &Analysis, sink: &mut Sink) {
+    for r in &p.rows {
+        if !a.never_matches[r.position as usize] || !from_reachable(r, a) {
+            continue;
+        }
+        let Condition::When(c) = &r.cond else {
+            continue;
+        };
+        let d = if r.is_entry && matches!(r.from, From::State(s) if s != StateId::S0) {
+            Diagnostic::error(
+                Code::UnreachableRow,
+                format!(
+                    "row {} tests `new_command` but starts in a state other than S0",
+                    r.display_name()
+                ),
+                r.from_span,
+                "never the state on a new command's cycle",
+            )
+            .with_note("a new command resets the plan to S0 before the rows run")
+            .with_help("start the row from `*` or `S0`")
+        } else {
+            Diagnostic::error(
+                Code::UnreachableRow,
+                format!(
+                    "row {} can never match: its condition is always false",
+                    r.display_name()
+                ),
+                c.span,
+                "`false` is a conjunct of this condition",
+            )
+            .with_help("remove the row, or fix its condition")
+        };
+        sink.error(d);
+    }
+}
+
+/// Structural equality of conditions (spans ignored).
+fn same_expr(a: &Expr, b: &Expr) -> bool {
+    use ExprKind::*;
+    if a.ty != b.ty {
+        return false;
+    }
+    match (&a.kind, &b.kind) {
+        (Int(x), Int(y)) => x == y,
+        (Float(x), Float(y)) => x.to_bits() == y.to_bits(),
+        (Bool(x), Bool(y)) => x == y,
+        (Variant(e, v), Variant(f, w)) => e == f && v == w,
+        (Status(x), Status(y)) => x == y,
+        (NewCommand, NewCommand) | (StateCycles, StateCycles) | (PlanCycles, PlanCycles) => true,
+        (CmdParam(c, p), CmdParam(d, q)) => c == d && p == q,
+        (Var(x), Var(y)) => x == y,
+        (Buffer(x), Buffer(y)) => x == y,
+        (Field(x, i), Field(y, j)) | (Index(x, i), Index(y, j)) => i == j && same_expr(x, y),
+        (Call(h, xs), Call(k, ys)) => {
+            h == k && xs.len() == ys.len() && xs.iter().zip(ys).all(|(x, y)| same_expr(x, y))
+        }
+        (Sub(c, p), Sub(d, q)) => c == d && p == q,
+        (Unary(o, x), Unary(p, y)) => o == p && same_expr(x, y),
+        (Binary(o, x1, x2), Binary(p, y1, y2)) => o == p && same_expr(x1, y1) && same_expr(x2, y2),
+        (Cast(x), Cast(y)) => same_expr(x, y),
+        _ => false,
+    }
+}
+
+/// An earlier row whose state pattern covers this one's and whose condition
+/// is `true` or the same as this one's always matches first.
+pub(crate) fn check_shadowed_rows(c: &Controller, p: &Plan, a: &Analysis, sink: &mut Sink) {
+    for (j, later) in p.rows.iter().enumerate() {
+        let Condition::When(cond) = &later.cond else {
+            continue;
+        };
+        if a.never_matches[j] || !from_reachable(later, a) {
+            continue;
+        }
+        let shadow = p.rows[..j].iter().find(|earlier| {
+            let Condition::When(ec) = &earlier.cond else {
+                return false;
+            };
+            if a.never_matches[earlier.position as usize] {
+                return false;
+            }
+            let covers = match (&earlier.from, &later.from) {
+                (From::DontCare(_), _) => true,
+                (From::State(x), From::State(y)) => x == y,
+                (From::State(_), From::DontCare(_)) => false,
+            };
+            covers && (matches!(ec.kind, ExprKind::Bool(true)) || same_expr(ec, cond))
+        });
+        if let Some(e) = shadow {
+            sink.lint(
+                Some(c),
+                Some(p),
+                Diagnostic::lint(
+                    Lint::ShadowedRow,
+                    format!(
+                        "row {} of plan `{}` never fires: an earlier row always matches first",
+                        later.display_name(),
+                        verb(c, p)
+                    ),
+                    later.cond_span,
+                    "whenever this row would match",
+                )
+                .with_secondary(e.span, "this earlier row matches first")
+                .with_note(
+                    "rows are tried in precedence order and only the first match fires (§4.2.2)",
+                )
+                .with_help("reorder the rows or make this condition more specific"),
+            );
+        }
+    }
+}
+
+pub(crate) fn check_double_commands(ir: &Ir, p: &Plan, sink: &mut Sink) {
+    for r in &p.rows {
+        let sends: Vec<(crate::ir::CtrlId, crate::source::Span)> = r
+            .jobs
+            .iter()
+            .filter_map(|j| match j {
+                Job::Send { sub, span, .. } => Some((*sub, *span)),
+                _ => None,
+            })
+            .collect();
+        for (i, (sub, span)) in sends.iter().enumerate() {
+            if let Some((_, first)) = sends[..i].iter().find(|(s, _)| s == sub) {
+                let name = &ir.controllers[sub.index()].name;
+                sink.error(
+                    Diagnostic::error(
+                        Code::DoubleCommand,
+                        format!("row {} sends two commands to `{name}`", r.display_name()),
+                        *span,
+                        "second command",
+                    )
+                    .with_secondary(*first, "first command")
+                    .with_note("commands are not queued: the second would overwrite the first in the same cycle (§3.8.5)")
+                    .with_help("send one command per subordinate per row; sequence them through states"),
+                );
+            }
+        }
+    }
+}
+
+pub(crate) fn check_rule_of_ten(ir: &Ir, c: &Controller, p: &Plan, sink: &mut Sink) {
+    let max = ir.limits.max_rules_per_plan as usize;
+    let counted: Vec<&Row> = p.rows.iter().filter(|r| !r.is_otherwise()).collect();
+    if counted.len() <= max {
+        return;
+    }
+    sink.lint(
+        Some(c),
+        Some(p),
+        Diagnostic::lint(
+            Lint::RuleOfTen,
+            format!(
+                "plan `{}` has {} rows; the limit is {max}",
+                verb(c, p),
+                counted.len()
+            ),
+            p.header,
+            "too many rows",
+        )
+        .with_secondary(
+            counted[max].span,
+            format!("row {} is over the limit", max + 1),
+        )
+        .with_note("a plan with more rules is hard to review and test (§3.4, §4.2.1)")
+        .with_help("split the task: add a subordinate, or move a sequence into another plan"),
+    );
+}

@@ -1,0 +1,224 @@
+//! Checks of how declarations are used: `float_equality` and `unused`.
+
+use super::Sink;
+use crate::ast::BinOp;
+use crate::diagnostic::Diagnostic;
+use crate::ir::{ExprKind, Ir, Job, PlaceRoot, Target, Type};
+use crate::lint::Lint;
+
+pub(crate) fn check_float_equality(ir: &Ir, sink: &mut Sink) {
+    for c in &ir.controllers {
+        for p in &c.plans {
+            for r in &p.rows {
+                let mut found = Vec::new();
+                r.visit_exprs(&mut |e| {
+                    if let ExprKind::Binary(op @ (BinOp::Eq | BinOp::Ne), l, _) = &e.kind {
+                        if matches!(l.ty, Type::Float(_)) {
+                            found.push((*op, e.span));
+                        }
+                    }
+                });
+                for (op, span) in found {
+                    sink.lint(
+                        Some(c),
+                        Some(p),
+                        Diagnostic::lint(
+                            Lint::FloatEquality,
+                            format!("floats compared with `{}`", op.symbol()),
+                            span,
+                            "exact float comparison",
+                        )
+                        .with_note(
+                            "measured values rarely equal a float exactly; the row may never fire",
+                        )
+                        .with_help(
+                            "compare within a tolerance: `x > goal - 0.5 && x < goal + 0.5`",
+                        ),
+                    );
+                }
+            }
+        }
+    }
+}
+
+fn mentions_type(t: &Type, f: &mut dyn FnMut(&Type)) {
+    f(t);
+    if let Type::Array(e, _) = t {
+        mentions_type(e, f);
+    }
+}
+
+pub(crate) fn check_unused(ir: &Ir, sink: &mut Sink) {
+    let mut enum_used = vec![false; ir.enums.len()];
+    let mut btype_used = vec![false; ir.buffer_types.len()];
+    let mark = |t: &Type, enum_used: &mut Vec<bool>, btype_used: &mut Vec<bool>| {
+        mentions_type(t, &mut |t| match t {
+            Type::Enum(e) => enum_used[e.index()] = true,
+            Type::Buffer(b) => btype_used[b.index()] = true,
+            _ => {}
+        })
+    };
+    for b in &ir.buffer_types {
+        for f in &b.fields {
+            mark(&f.ty, &mut enum_used, &mut btype_used);
+        }
+    }
+    for b in &ir.buffers {
+        btype_used[b.ty.index()] = true;
+    }
+    // Statuses are used by `report` in their controller or by a supervisor's comparison.
+    let mut status_used: Vec<Vec<bool>> = ir
+        .controllers
+        .iter()
+        .map(|c| vec![false; c.statuses.len()])
+        .collect();
+    for c in &ir.controllers {
+        for t in c
+            .commands
+            .iter()
+            .flat_map(|k| &k.params)
+            .map(|p| &p.ty)
+            .chain(c.vars.iter().map(|v| &v.ty))
+            .chain(c.hooks.iter().flat_map(|h| {
+                h.params
+                    .iter()
+                    .map(|p| &p.ty)
+                    .chain(std::iter::once(&h.ret))
+            }))
+        {
+            mark(t, &mut enum_used, &mut btype_used);
+        }
+        for p in &c.plans {
+            for r in &p.rows {
+                r.visit_exprs(&mut |e| {
+                    if let ExprKind::Variant(en, _) = e.kind {
+                        enum_used[en.index()] = true;
+                    }
+                    if let (ExprKind::Status(s), Type::Status(owner)) = (&e.kind, &e.ty) {
+                        status_used[owner.index()][s.index()] = true;
+                    }
+                });
+            }
+        }
+    }
+    for (ci, c) in ir.controllers.iter().enumerate() {
+        let mut var_used = vec![false; c.vars.len()];
+        let mut hook_used = vec![false; c.hooks.len()];
+        let mut error_used = vec![false; c.errors.len()];
+        let mut buffer_used = vec![false; ir.buffers.len()];
+        for p in &c.plans {
+            for r in &p.rows {
+                if let Target::Error(Some(e)) = r.to {
+                    error_used[e.index()] = true;
+                }
+                r.visit_exprs(&mut |e| match &e.kind {
+                    ExprKind::Var(v) => var_used[v.index()] = true,
+                    ExprKind::Call(h, _) => hook_used[h.index()] = true,
+                    ExprKind::Buffer(b) => buffer_used[b.index()] = true,
+                    _ => {}
+                });
+                for j in &r.jobs {
+                    match j {
+                        Job::Assign { place, .. } => match place.root {
+                            PlaceRoot::Var(v) => var_used[v.index()] = true,
+                            PlaceRoot::Buffer(b) => buffer_used[b.index()] = true,
+                        },
+                        Job::Report { status, .. } => status_used[ci][status.index()] = true,
+                        _ => {}
+                    }
+                }
+            }
+        }
+        let mut report = |what: &str, name: &str, span, help: &str| {
+            sink.lint(
+                Some(c),
+                None,
+                Diagnostic::lint(
+                    Lint::Unused,
+                    format!("{what} `{name}` of `{}` is never used", c.name),
+                    span,
+                    "declared here",
+                )
+                .with_help(help.to_string()),
+            );
+        };
+        for (v, used) in c.vars.iter().zip(&var_used) {
+            if !used {
+                report("var", &v.name, v.span, "remove it, or use it in a plan");
+            }
+        }
+        for (h, used) in c.hooks.iter().zip(&hook_used) {
+            if !used {
+                report("hook", &h.name, h.span, "remove it, or call it from a row");
+            }
+        }
+        for (e, used) in c.errors.iter().zip(&error_used) {
+            if !used {
+                report(
+                    "error code",
+                    &e.name,
+                    e.span,
+                    "remove it, or end a row with `-> Error(CODE)`",
+                );
+            }
+        }
+        for (s, used) in c.statuses.iter().zip(&status_used[ci]).skip(4) {
+            if let (false, Some(span)) = (used, s.span) {
+                report(
+                    "status",
+                    &s.name,
+                    span,
+                    "remove it, or `report` it from a row",
+                );
+            }
+        }
+        for b in c.reads.iter().chain(&c.writes) {
+            if !buffer_used[b.index()] {
+                let span = c.span;
+                let name = &ir.buffers[b.index()].name;
+                let _ = span;
+                report(
+                    "buffer",
+                    name,
+                    buffer_decl_span(ir, c, name),
+                    "remove the `reads`/`writes` line, or use the buffer in a plan",
+                );
+            }
+        }
+    }
+    for (e, used) in ir.enums.iter().zip(&enum_used) {
+        if !used {
+            sink.lint(
+                None,
+                None,
+                Diagnostic::lint(
+                    Lint::Unused,
+                    format!("enum `{}` is never used", e.name),
+                    e.span,
+                    "declared here",
+                )
+                .with_help("remove it, or use it as a field, parameter or var type"),
+            );
+        }
+    }
+    for (b, used) in ir.buffer_types.iter().zip(&btype_used) {
+        if !used {
+            sink.lint(
+                None,
+                None,
+                Diagnostic::lint(
+                    Lint::Unused,
+                    format!("buffer type `{}` is never used", b.name),
+                    b.span,
+                    "declared here",
+                )
+                .with_help("remove it, or name it in a `reads` or `writes` line"),
+            );
+        }
+    }
+}
+
+/// The controller's span stands in when no finer one is kept.
+fn buffer_decl_span(_ir: &Ir, c: &crate::ir::Controller, _name: &str) -> crate::source::Span {
+    c.name_span
+}

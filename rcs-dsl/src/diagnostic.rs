@@ -1,0 +1,317 @@
+//! Diagnostics: what every stage of the pipeline returns instead of
+//! failing. The library only collects them; the CLI (or build.rs `Config`)
+//! renders them with [`crate::render`].
+//!
+//! Every diagnostic has a stable [`Code`] from one catalogue, a severity, a
+//! primary span with a label, optional secondary spans, notes and a help line.
+
+use crate::lint::{Level, Lint};
+use crate::source::{SourceMap, Span};
+use serde::Serialize;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Severity {
+    Error,
+    Warning,
+}
+
+impl Severity {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+        }
+    }
+}
+
+/// The catalogue of diagnostic codes. Codes are stable: tests, CI and
+/// editors key on [`Code::name`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Code {
+    Syntax,
+    DuplicateDefinition,
+    UnknownName,
+    UnknownCommand,
+    UnknownSubordinate,
+    TypeMismatch,
+    WrongArguments,
+    AssignToInput,
+    RowNumber,
+    OtherwiseNotLast,
+    EntryMissing,
+    EntryNotFirst,
+    UnreachableRow,
+    DoubleCommand,
+    MissingPlan,
+    MultipleSupervisors,
+    HierarchyCycle,
+    MultipleWriters,
+    BufferTypeConflict,
+    Manifest,
+    Lint(Lint),
+}
+
+impl Code {
+    /// Every hard-error code, in catalogue order (lints follow in [`Lint::ALL`]).
+    pub const ERRORS: [Code; 20] = [
+        Code::Syntax,
+        Code::DuplicateDefinition,
+        Code::UnknownName,
+        Code::UnknownCommand,
+        Code::UnknownSubordinate,
+        Code::TypeMismatch,
+        Code::WrongArguments,
+        Code::AssignToInput,
+        Code::RowNumber,
+        Code::OtherwiseNotLast,
+        Code::EntryMissing,
+        Code::EntryNotFirst,
+        Code::UnreachableRow,
+        Code::DoubleCommand,
+        Code::MissingPlan,
+        Code::MultipleSupervisors,
+        Code::HierarchyCycle,
+        Code::MultipleWriters,
+        Code::BufferTypeConflict,
+        Code::Manifest,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Code::Syntax => "syntax",
+            Code::DuplicateDefinition => "duplicate_definition",
+            Code::UnknownName => "unknown_name",
+            Code::UnknownCommand => "unknown_command",
+            Code::UnknownSubordinate => "unknown_subordinate",
+            Code::TypeMismatch => "type_mismatch",
+            Code::WrongArguments => "wrong_arguments",
+            Code::AssignToInput => "assign_to_input",
+            Code::RowNumber => "row_number",
+            Code::OtherwiseNotLast => "otherwise_not_last",
+            Code::EntryMissing => "entry_missing",
+            Code::EntryNotFirst => "entry_not_first",
+            Code::UnreachableRow => "unreachable_row",
+            Code::DoubleCommand => "double_command",
+            Code::MissingPlan => "missing_plan",
+            Code::MultipleSupervisors => "multiple_supervisors",
+            Code::HierarchyCycle => "hierarchy_cycle",
+            Code::MultipleWriters => "multiple_writers",
+            Code::BufferTypeConflict => "buffer_type_conflict",
+            Code::Manifest => "manifest",
+            Code::Lint(l) => l.name(),
+        }
+    }
+
+    /// One line saying what the code means, for `docs/` and `--explain`.
+    pub fn summary(self) -> &'static str {
+        match self {
+            Code::Syntax => "the text does not parse",
+            Code::DuplicateDefinition => "two definitions share one name",
+            Code::UnknownName => "a name is not declared",
+            Code::UnknownCommand => "a verb the controller does not declare",
+            Code::UnknownSubordinate => "a controller that is not a subordinate here",
+            Code::TypeMismatch => "the types of an expression disagree",
+            Code::WrongArguments => "missing, extra or repeated arguments",
+            Code::AssignToInput => "a job assigns to an input",
+            Code::RowNumber => "a row's number is not its precedence position",
+            Code::OtherwiseNotLast => "`otherwise` is not the single last row",
+            Code::EntryMissing => "no row handles a new command",
+            Code::EntryNotFirst => "a new-command row stands after an ordinary row",
+            Code::UnreachableRow => "a row can never match",
+            Code::DoubleCommand => "one row commands a subordinate twice",
+            Code::MissingPlan => "a command has no plan",
+            Code::MultipleSupervisors => "a controller has two supervisors",
+            Code::HierarchyCycle => "a controller is above itself",
+            Code::MultipleWriters => "a buffer has two writers",
+            Code::BufferTypeConflict => "one buffer name has two types",
+            Code::Manifest => "`rcs.yaml` is malformed",
+            Code::Lint(Lint::RuleOfTen) => "a plan has more rows than the rule of ten allows",
+            Code::Lint(Lint::ShadowedRow) => "earlier rows always match before this row",
+            Code::Lint(Lint::UnreachableState) => "no path from the entry reaches a state",
+            Code::Lint(Lint::DeadEndState) => "a state has no way out",
+            Code::Lint(Lint::NoDone) => "a plan never reaches `Done` or `Error`",
+            Code::Lint(Lint::SpanOfControl) => "a supervisor has too many subordinates",
+            Code::Lint(Lint::LevelOrder) => "a subordinate's level is not below its supervisor's",
+            Code::Lint(Lint::FloatEquality) => "floats compared with `==` or `!=`",
+            Code::Lint(Lint::Unused) => "a declaration is never used",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Code> {
+        Code::ERRORS
+            .into_iter()
+            .find(|c| c.name() == name)
+            .or_else(|| Lint::from_name(name).map(Code::Lint))
+    }
+}
+
+/// A labelled span. The primary label says what is wrong; secondary labels
+/// point at related places ("first defined here").
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Label {
+    pub span: Span,
+    pub message: String,
+    pub primary: bool,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Diagnostic {
+    pub code: Code,
+    pub severity: Severity,
+    pub message: String,
+    /// The primary label comes first; there is always exactly one.
+    pub labels: Vec<Label>,
+    pub notes: Vec<String>,
+    pub help: Option<String>,
+}
+
+impl Diagnostic {
+    /// An error with its primary label.
+    pub fn error(
+        code: Code,
+        message: impl Into<String>,
+        span: Span,
+        label: impl Into<String>,
+    ) -> Self {
+        Diagnostic {
+            code,
+            severity: Severity::Error,
+            message: message.into(),
+            labels: vec![Label {
+                span,
+                message: label.into(),
+                primary: true,
+            }],
+            notes: Vec::new(),
+            help: None,
+        }
+    }
+
+    /// A lint finding; its severity is settled by [`Diagnostic::at_level`].
+    pub fn lint(
+        lint: Lint,
+        message: impl Into<String>,
+        span: Span,
+        label: impl Into<String>,
+    ) -> Self {
+        let mut d = Diagnostic::error(Code::Lint(lint), message, span, label);
+        d.severity = Severity::Warning;
+        d
+    }
+
+    pub fn with_secondary(mut self, span: Span, label: impl Into<String>) -> Self {
+        self.labels.push(Label {
+            span,
+            message: label.into(),
+            primary: false,
+        });
+        self
+    }
+
+    pub fn with_note(mut self, note: impl Into<String>) -> Self {
+        self.notes.push(note.into());
+        self
+    }
+
+    pub fn with_help(mut self, help: impl Into<String>) -> Self {
+        self.help = Some(help.into());
+        self
+    }
+
+    pub fn primary_span(&self) -> Span {
+        self.labels[0].span
+    }
+
+    /// Apply a lint level: `None` when the lint is allowed here.
+    /// `is_default` says whether the level is the lint's default (rustc's
+    /// "on by default" note) or was set by the manifest, a flag or an attribute.
+    pub fn at_level(mut self, level: Level, is_default: bool) -> Option<Diagnostic> {
+        let name = self.code.name();
+        let how = if is_default {
+            "on by default"
+        } else {
+            "set for this scope"
+        };
+        let (severity, note) = match level {
+            Level::Allow => return None,
+            Level::Warn => (Severity::Warning, format!("`#[warn({name})]` {how}")),
+            Level::Deny => (Severity::Error, format!("`#[deny({name})]` {how}")),
+        };
+        self.severity = severity;
+        self.notes.push(note);
+        Some(self)
+    }
+}
+
+/// The one list every check pushes into.
+#[derive(Clone, Debug, Default)]
+pub struct Diagnostics {
+    list: Vec<Diagnostic>,
+}
+
+impl Diagnostics {
+    pub fn new() -> Self {
+        Diagnostics::default()
+    }
+
+    pub fn push(&mut self, d: Diagnostic) {
+        self.list.push(d);
+    }
+
+    /// The diagnostic pushed last, to add a help line or label to it.
+    pub fn last_mut(&mut self) -> Option<&mut Diagnostic> {
+        self.list.last_mut()
+    }
+
+    pub fn has_errors(&self) -> bool {
+        self.list.iter().any(|d| d.severity == Severity::Error)
+    }
+
+    pub fn error_count(&self) -> usize {
+        self.list
+            .iter()
+            .filter(|d| d.severity == Severity::Error)
+            .count()
+    }
+
+    pub fn warning_count(&self) -> usize {
+        self.list
+            .iter()
+            .filter(|d| d.severity == Severity::Warning)
+            .count()
+    }
+
+    pub fn iter(&self) -> impl Iterator<Item = &Diagnostic> {
+        self.list.iter()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.list.is_empty()
+    }
+
+    pub fn len(&self) -> usize {
+        self.list.len()
+    }
+
+    pub fn extend(&mut self, other: Diagnostics) {
+        self.list.extend(other.list);
+    }
+
+    /// Order a stage's findings by where they point (file path, offset),
+    /// then by code, so output never depends on traversal details.
+    pub fn sort_from(&mut self, start: usize, sources: &SourceMap) {
+        self.list[start..].sort_by(|a, b| {
+            let ka = sources.order_key(a.primary_span());
+            let kb = sources.order_key(b.primary_span());
+            ka.cmp(&kb)
+                .then(a.primary_span().end.cmp(&b.primary_span().end))
+                .then(a.code.cmp(&b.code))
+        });
+    }
+
+    pub fn into_vec(self) -> Vec<Diagnostic> {
+        self.list
+    }
+}

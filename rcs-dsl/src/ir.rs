@@ -1,0 +1,571 @@
+//! The IR: the single, fully resolved input of every back end (Rust code,
+//! graphs, tables) and of the interpreter. Produced by `lower`, read (never
+//! changed) by `checks`.
+//!
+//! Plain data: entities live in `Vec`s and refer to each other by typed ids
+//! (`CtrlId`, `PlanId`, `StateId`, `RowId`, …) that index those `Vec`s.
+//! Every list is in a deterministic order: files sorted by path, then source
+//! order. Spans sit beside the data for diagnostics and row comments.
+
+use crate::ast::{AssignOp, BinOp, UnOp};
+use crate::lint::LintOverride;
+use crate::source::Span;
+use serde::Serialize;
+
+macro_rules! id {
+    ($(#[$m:meta])* $name:ident) => {
+        $(#[$m])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+        #[serde(transparent)]
+        pub struct $name(pub u32);
+        impl $name {
+            pub fn index(self) -> usize {
+                self.0 as usize
+            }
+        }
+    };
+}
+
+id!(/// Index into [`Ir::enums`].
+    EnumId);
+id!(/// Index into [`Ir::buffer_types`].
+    BufferTypeId);
+id!(/// Index into [`Ir::buffers`] (Global Memory instances).
+    BufferId);
+id!(/// Index into [`Ir::controllers`].
+    CtrlId);
+id!(/// Index into [`Controller::commands`].
+    CommandId);
+id!(/// Index into [`Command::params`].
+    ParamId);
+id!(/// Index into [`Controller::statuses`]; 0..=3 are the built-ins.
+    StatusId);
+id!(/// Index into [`Controller::errors`].
+    ErrorId);
+id!(/// Index into [`Controller::vars`].
+    VarId);
+id!(/// Index into [`Controller::hooks`].
+    HookId);
+id!(/// Index into [`Controller::plans`].
+    PlanId);
+id!(/// Index into [`Plan::states`]; `StateId(0)` is always `S0`.
+    StateId);
+id!(/// Index into [`Plan::rows`], equal to the row's precedence position.
+    RowId);
+
+impl StateId {
+    /// The state a plan is in right after a new command arrives.
+    pub const S0: StateId = StateId(0);
+}
+
+impl StatusId {
+    pub const NOT_READY: StatusId = StatusId(0);
+    pub const EXECUTING: StatusId = StatusId(1);
+    pub const DONE: StatusId = StatusId(2);
+    pub const ERROR: StatusId = StatusId(3);
+    /// Names of the built-in statuses, in id order.
+    pub const BUILTIN: [&'static str; 4] = ["NOT_READY", "EXECUTING", "DONE", "ERROR"];
+}
+
+/// A validated plan set.
+#[derive(Clone, Debug, Serialize)]
+pub struct Ir {
+    /// Name of the generated system module.
+    pub system: String,
+    /// Display paths of the source files, in `FileId` order.
+    pub files: Vec<String>,
+    pub limits: Limits,
+    pub enums: Vec<EnumDef>,
+    pub buffer_types: Vec<BufferType>,
+    /// Global Memory instances. Invariant: at most one writer each.
+    pub buffers: Vec<Buffer>,
+    pub controllers: Vec<Controller>,
+    /// The executives. Invariant: every controller appears exactly once.
+    pub schedule: Vec<Cpu>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Limits {
+    pub max_rules_per_plan: u32,
+    pub max_subordinates: u32,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_rules_per_plan: 10,
+            max_subordinates: 9,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct EnumDef {
+    pub name: String,
+    pub docs: Vec<String>,
+    /// Invariant: at least one variant; the first is the zero value.
+    pub variants: Vec<Variant>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Variant {
+    pub name: String,
+    pub docs: Vec<String>,
+    pub span: Span,
+}
+
+/// A buffer schema (`buffer Name { … }`): plain, fixed-size data.
+#[derive(Clone, Debug, Serialize)]
+pub struct BufferType {
+    pub name: String,
+    pub docs: Vec<String>,
+    pub fields: Vec<FieldDef>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct FieldDef {
+    pub name: String,
+    pub docs: Vec<String>,
+    pub ty: Type,
+    pub span: Span,
+}
+
+/// A Global Memory buffer instance named by `reads`/`writes`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Buffer {
+    pub name: String,
+    pub ty: BufferTypeId,
+    /// `None`: an external input (a sensor driver or simulator writes it).
+    pub writer: Option<CtrlId>,
+    pub readers: Vec<CtrlId>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IntTy {
+    I8,
+    I16,
+    I32,
+    I64,
+    U8,
+    U16,
+    U32,
+    U64,
+}
+
+impl IntTy {
+    pub fn name(self) -> &'static str {
+        match self {
+            IntTy::I8 => "i8",
+            IntTy::I16 => "i16",
+            IntTy::I32 => "i32",
+            IntTy::I64 => "i64",
+            IntTy::U8 => "u8",
+            IntTy::U16 => "u16",
+            IntTy::U32 => "u32",
+            IntTy::U64 => "u64",
+        }
+    }
+
+    pub fn signed(self) -> bool {
+        matches!(self, IntTy::I8 | IntTy::I16 | IntTy::I32 | IntTy::I64)
+    }
+
+    /// Inclusive range of values, widened to i128.
+    pub fn range(self) -> (i128, i128) {
+        match self {
+            IntTy::I8 => (i8::MIN as i128, i8::MAX as i128),
+            IntTy::I16 => (i16::MIN as i128, i16::MAX as i128),
+            IntTy::I32 => (i32::MIN as i128, i32::MAX as i128),
+            IntTy::I64 => (i64::MIN as i128, i64::MAX as i128),
+            IntTy::U8 => (0, u8::MAX as i128),
+            IntTy::U16 => (0, u16::MAX as i128),
+            IntTy::U32 => (0, u32::MAX as i128),
+            IntTy::U64 => (0, u64::MAX as i128),
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FloatTy {
+    F32,
+    F64,
+}
+
+impl FloatTy {
+    pub fn name(self) -> &'static str {
+        match self {
+            FloatTy::F32 => "f32",
+            FloatTy::F64 => "f64",
+        }
+    }
+}
+
+/// A resolved type.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Type {
+    Bool,
+    Int(IntTy),
+    Float(FloatTy),
+    Enum(EnumId),
+    Buffer(BufferTypeId),
+    Array(Box<Type>, u32),
+    /// The status of a controller (built-ins plus its custom statuses).
+    Status(CtrlId),
+    /// What a hook without a return type gives.
+    Unit,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Controller {
+    pub name: String,
+    pub title: Option<String>,
+    pub docs: Vec<String>,
+    pub level: Option<u32>,
+    /// Invariant: at most one supervisor (checked by `multiple_supervisors`).
+    pub supervisor: Option<CtrlId>,
+    pub subordinates: Vec<CtrlId>,
+    /// Buffers read every cycle, in declaration order.
+    pub reads: Vec<BufferId>,
+    /// Buffers this controller alone writes, in declaration order.
+    pub writes: Vec<BufferId>,
+    pub commands: Vec<Command>,
+    /// Built-ins (`NOT_READY`, `EXECUTING`, `DONE`, `ERROR`) first, then custom.
+    pub statuses: Vec<StatusDef>,
+    pub errors: Vec<ErrorDef>,
+    pub vars: Vec<Var>,
+    pub hooks: Vec<Hook>,
+    /// One per command, in command order once checks pass.
+    pub plans: Vec<Plan>,
+    pub lints: Vec<LintOverride>,
+    pub span: Span,
+    pub name_span: Span,
+    /// Where each subordinate is named in `subordinates` (parallel to it).
+    pub subordinate_spans: Vec<Span>,
+    /// The span of each `subordinates` list as written.
+    pub subordinates_lists: Vec<Span>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Command {
+    pub name: String,
+    pub docs: Vec<String>,
+    pub params: Vec<Param>,
+    pub plan: Option<PlanId>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Param {
+    pub name: String,
+    pub ty: Type,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct StatusDef {
+    pub name: String,
+    pub docs: Vec<String>,
+    /// `None` for the built-ins.
+    pub span: Option<Span>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ErrorDef {
+    pub name: String,
+    pub docs: Vec<String>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Var {
+    pub name: String,
+    pub docs: Vec<String>,
+    pub ty: Type,
+    /// `None`: the type's zero value.
+    pub init: Option<Expr>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Hook {
+    pub name: String,
+    pub docs: Vec<String>,
+    pub params: Vec<Param>,
+    /// `Type::Unit` when the hook returns nothing.
+    pub ret: Type,
+    pub span: Span,
+}
+
+/// One rule plan: the state table of one command verb.
+#[derive(Clone, Debug, Serialize)]
+pub struct Plan {
+    pub verb: CommandId,
+    pub docs: Vec<String>,
+    /// States in order of first mention; `states[0]` is `S0`.
+    pub states: Vec<State>,
+    /// Rows in precedence order; `rows[i].position == i`.
+    pub rows: Vec<Row>,
+    pub lints: Vec<LintOverride>,
+    /// `plan VERB`.
+    pub header: Span,
+    pub span: Span,
+}
+
+impl Plan {
+    /// The `otherwise` row, if the plan has one (the last row once checked).
+    pub fn otherwise(&self) -> Option<&Row> {
+        self.rows.iter().find(|r| r.is_otherwise())
+    }
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct State {
+    pub name: String,
+    /// First mention; `None` for an `S0` that is never written.
+    pub span: Option<Span>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Row {
+    /// 0-based precedence position.
+    pub position: u32,
+    /// `EN` as written.
+    pub label: Option<u32>,
+    pub docs: Vec<String>,
+    pub from: From,
+    /// `Condition::Otherwise` fires only when no other row matched.
+    pub cond: Condition,
+    /// The row tests `new_command` as a top-level conjunct: an entry row.
+    pub is_entry: bool,
+    pub to: Target,
+    pub jobs: Vec<Job>,
+    /// 1-based line of the row in its file, for generated comments.
+    pub line: u32,
+    pub span: Span,
+    pub from_span: Span,
+    pub cond_span: Span,
+    pub to_span: Span,
+    pub label_span: Option<Span>,
+}
+
+impl Row {
+    pub fn is_otherwise(&self) -> bool {
+        matches!(self.cond, Condition::Otherwise)
+    }
+
+    pub fn is_dont_care(&self) -> bool {
+        matches!(self.from, From::DontCare(_))
+    }
+
+    /// Every name a scenario may use for this row: `EN`, `*N`, `otherwise`, `#N`.
+    pub fn display_name(&self) -> String {
+        match (&self.label, &self.from) {
+            (Some(n), _) => format!("E{n}"),
+            (None, From::DontCare(Some(n))) => format!("*{n}"),
+            (None, _) if self.is_otherwise() => "otherwise".to_string(),
+            _ => format!("#{}", self.position),
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum From {
+    /// `*` / `*N` (with N as written, if any), or an `otherwise` without `*`.
+    DontCare(Option<u32>),
+    State(StateId),
+}
+
+#[derive(Clone, Debug, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Condition {
+    When(Expr),
+    Otherwise,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Target {
+    State(StateId),
+    Same,
+    Done,
+    Error(Option<ErrorId>),
+}
+
+#[derive(Clone, Debug, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Job {
+    Assign {
+        place: Place,
+        op: AssignOp,
+        value: Expr,
+        span: Span,
+    },
+    /// `X <- VERB(args)`; `args` are in the verb's parameter order.
+    Send {
+        sub: CtrlId,
+        command: CommandId,
+        args: Vec<Expr>,
+        span: Span,
+    },
+    Report {
+        status: StatusId,
+        span: Span,
+    },
+    /// A hook called for its effect; `call` is an `ExprKind::Call`.
+    Call(Expr),
+}
+
+/// Something a job may assign to: a var or a `writes` buffer, then fields
+/// and constant indices.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Place {
+    pub root: PlaceRoot,
+    pub path: Vec<Projection>,
+    pub ty: Type,
+    pub span: Span,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlaceRoot {
+    Var(VarId),
+    Buffer(BufferId),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Projection {
+    /// Field index in the buffer type.
+    Field(u32),
+    /// Constant array index (checked in bounds).
+    Index(u32),
+}
+
+/// A typed expression. `ty` is always concrete (literals take the type their
+/// context fixes; unconstrained integer literals are `i64`, floats `f64`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Expr {
+    pub kind: ExprKind,
+    pub ty: Type,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ExprKind {
+    Int(i128),
+    Float(f64),
+    Bool(bool),
+    Variant(EnumId, u32),
+    /// A status of the controller given by the expression's type.
+    Status(StatusId),
+    NewCommand,
+    StateCycles,
+    PlanCycles,
+    /// Parameter of the command being executed; only in the plan of that command.
+    CmdParam(CommandId, ParamId),
+    Var(VarId),
+    /// A `reads` or `writes` buffer as a whole.
+    Buffer(BufferId),
+    Field(Box<Expr>, u32),
+    Index(Box<Expr>, u32),
+    Call(HookId, Vec<Expr>),
+    /// `X.status`, `X.done`, … seen through the handshake.
+    Sub(CtrlId, SubProp),
+    Unary(UnOp, Box<Expr>),
+    Binary(BinOp, Box<Expr>, Box<Expr>),
+    Cast(Box<Expr>),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SubProp {
+    Status,
+    Done,
+    Executing,
+    Error,
+    StaleCycles,
+}
+
+impl SubProp {
+    pub fn name(self) -> &'static str {
+        match self {
+            SubProp::Status => "status",
+            SubProp::Done => "done",
+            SubProp::Executing => "executing",
+            SubProp::Error => "error",
+            SubProp::StaleCycles => "stale_cycles",
+        }
+    }
+}
+
+/// One executive ("CPU"): its period and its controllers in run order.
+#[derive(Clone, Debug, Serialize)]
+pub struct Cpu {
+    pub name: String,
+    pub period_ns: u64,
+    pub order: Vec<CtrlId>,
+}
+
+impl Ir {
+    pub fn controller(&self, id: CtrlId) -> &Controller {
+        &self.controllers[id.index()]
+    }
+
+    pub fn controller_by_name(&self, name: &str) -> Option<CtrlId> {
+        self.controllers
+            .iter()
+            .position(|c| c.name == name)
+            .map(|i| CtrlId(i as u32))
+    }
+}
+
+impl Controller {
+    /// The plan of a verb, by name.
+    pub fn plan_of(&self, verb: &str) -> Option<&Plan> {
+        let c = self.commands.iter().find(|c| c.name == verb)?;
+        c.plan.map(|p| &self.plans[p.index()])
+    }
+}
+
+impl Expr {
+    /// Call `f` on this expression and every sub-expression, parents first.
+    pub fn visit(&self, f: &mut dyn FnMut(&Expr)) {
+        f(self);
+        match &self.kind {
+            ExprKind::Field(e, _)
+            | ExprKind::Index(e, _)
+            | ExprKind::Unary(_, e)
+            | ExprKind::Cast(e) => e.visit(f),
+            ExprKind::Binary(_, l, r) => {
+                l.visit(f);
+                r.visit(f);
+            }
+            ExprKind::Call(_, args) => args.iter().for_each(|a| a.visit(f)),
+            _ => {}
+        }
+    }
+}
+
+impl Row {
+    /// Every expression of the row: its condition, then its jobs' in order.
+    pub fn visit_exprs(&self, f: &mut dyn FnMut(&Expr)) {
+        if let Condition::When(c) = &self.cond {
+            c.visit(f);
+        }
+        for j in &self.jobs {
+            match j {
+                Job::Assign { value, .. } => value.visit(f),
+                Job::Send { args, .. } => args.iter().for_each(|a| a.visit(f)),
+                Job::Call(e) => e.visit(f),
+                Job::Report { .. } => {}
+            }
+        }
+    }
+}

@@ -1,0 +1,126 @@
+//! `rcs-dsl`: the front end of rcsc.
+//!
+//! The pipeline is one way, one type per stage:
+//!
+//! ```text
+//! paths ──load──▶ PlanSet ──parse──▶ ast::File ──lower──▶ ir::Ir ──checks──▶ findings
+//! ```
+//!
+//! [`check`] runs it. Each stage reports all of its errors and the pipeline
+//! stops after a stage that found any, so one mistake gives one diagnostic.
+//! The IR is returned only when no error was found; it is the input of the
+//! code generator, the graph writer and the interpreter.
+
+pub mod ast;
+mod checks;
+pub mod diagnostic;
+pub mod ir;
+pub mod lint;
+pub mod load;
+mod lower;
+pub mod manifest;
+pub mod parser;
+pub mod render;
+pub mod source;
+
+pub use diagnostic::{Code, Diagnostic, Diagnostics, Severity};
+pub use load::{load_folder, load_paths, LoadError, PlanSet};
+pub use lower::type_name;
+
+use lint::{LintLevels, LintOverride};
+
+/// Settings that do not come from the plan set itself.
+#[derive(Clone, Debug, Default)]
+pub struct Options {
+    /// Command-line `-A/-W/-D` lint levels, in order.
+    pub lint_flags: Vec<LintOverride>,
+}
+
+/// The result of checking one plan set.
+#[derive(Debug)]
+pub struct Checked {
+    /// Present when no error was found (warnings allowed).
+    pub ir: Option<ir::Ir>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl Checked {
+    pub fn has_errors(&self) -> bool {
+        self.diagnostics
+            .iter()
+            .any(|d| d.severity == Severity::Error)
+    }
+}
+
+/// Check a loaded plan set: parse, lower, validate.
+pub fn check(set: &PlanSet, options: &Options) -> Checked {
+    let mut diags = Diagnostics::new();
+    // Stage 0 (load and manifest) and stage 1 (parse) are independent, so
+    // their errors are reported together.
+    let unreadable: Vec<source::FileId> = set
+        .diagnostics
+        .iter()
+        .map(|d| d.primary_span().file)
+        .collect();
+    for d in &set.diagnostics {
+        diags.push(d.clone());
+    }
+    let start = diags.len();
+    let mut files = Vec::with_capacity(set.rcs_files.len());
+    for &id in &set.rcs_files {
+        if unreadable.contains(&id) {
+            continue;
+        }
+        match parser::parse_file(id, &set.sources.get(id).text) {
+            Ok(f) => files.push(f),
+            Err(ds) => ds.into_iter().for_each(|d| diags.push(d)),
+        }
+    }
+    diags.sort_from(start, &set.sources);
+    if diags.has_errors() {
+        return finish(None, diags);
+    }
+
+    let system = set
+        .manifest
+        .system
+        .as_ref()
+        .map(|(s, _)| s.clone())
+        .unwrap_or_else(|| sanitize(&set.name));
+    let Some(ir) = lower::lower(&files, &set.manifest, &system, &set.sources, &mut diags) else {
+        return finish(None, diags);
+    };
+
+    let mut levels = LintLevels::default();
+    for &(lint, level) in set.manifest.lints.iter().chain(&options.lint_flags) {
+        levels.set(lint, level);
+    }
+    checks::run(&ir, &levels, &set.sources, &mut diags);
+    let ir = (!diags.has_errors()).then_some(ir);
+    finish(ir, diags)
+}
+
+fn finish(ir: Option<ir::Ir>, diags: Diagnostics) -> Checked {
+    Checked {
+        ir,
+        diagnostics: diags.into_vec(),
+    }
+}
+
+/// A folder name as a Rust-friendly system name.
+fn sanitize(name: &str) -> String {
+    let mut s: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if s.is_empty() || s.starts_with(|c: char| c.is_ascii_digit()) {
+        s.insert(0, '_');
+    }
+    s
+}

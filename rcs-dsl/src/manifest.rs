@@ -1,0 +1,265 @@
+//! `rcs.yaml`, the optional manifest at a plan set's root. This is the one
+//! module that touches YAML (through serde-saphyr); it yields a plain
+//! [`Manifest`] with spans into the YAML file, and `manifest` diagnostics.
+//!
+//! Names of controllers are checked later, in `lower`, where they are known.
+
+use crate::diagnostic::{Code, Diagnostic};
+use crate::ir::Limits;
+use crate::lint::{Level, Lint, LintOverride};
+use crate::source::{FileId, SourceFile, Span};
+use serde::Deserialize;
+use serde_saphyr::Spanned;
+use std::collections::BTreeMap;
+
+/// The default executive period when the manifest gives no schedule.
+pub const DEFAULT_PERIOD_NS: u64 = 10_000_000;
+
+#[derive(Clone, Debug, Default)]
+pub struct Manifest {
+    pub system: Option<(String, Span)>,
+    /// `plans:` entries (files or folders relative to the manifest).
+    pub plans: Option<Vec<(String, Span)>>,
+    pub limits: Limits,
+    pub lints: Vec<LintOverride>,
+    pub schedule: Option<Vec<CpuSpec>>,
+    /// The `schedule:` key, for diagnostics about the schedule as a whole.
+    pub schedule_span: Option<Span>,
+}
+
+#[derive(Clone, Debug)]
+pub struct CpuSpec {
+    pub name: String,
+    pub span: Span,
+    pub period_ns: u64,
+    pub order: Vec<(String, Span)>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Raw {
+    system: Option<Spanned<String>>,
+    plans: Option<Vec<Spanned<String>>>,
+    limits: Option<RawLimits>,
+    lints: Option<BTreeMap<String, Spanned<String>>>,
+    schedule: Option<Spanned<Vec<RawCpu>>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLimits {
+    max_rules_per_plan: Option<Spanned<u32>>,
+    max_subordinates: Option<Spanned<u32>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCpu {
+    cpu: Spanned<String>,
+    period: Option<Spanned<String>>,
+    order: Vec<Spanned<String>>,
+}
+
+/// Parse a manifest. Every problem is a `manifest` diagnostic in `file`.
+pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>> {
+    let span_of = |line: u64, column: u64, byte: Option<u64>, len: Option<u64>| -> Span {
+        let start = match byte {
+            Some(b) => (b as usize).min(file.text.len()),
+            None => offset_of(file, line, column),
+        };
+        let end = (start + len.unwrap_or(0) as usize).min(file.text.len());
+        Span::new(id, start, end)
+    };
+    let spanned = |loc: &serde_saphyr::Location| -> Span {
+        let s = loc.span();
+        let sp = span_of(loc.line(), loc.column(), s.byte_offset(), s.byte_len());
+        if sp.start == sp.end {
+            // Point at the rest of the line's token.
+            let rest = &file.text[sp.start as usize..];
+            let len = rest.find(['\n', '\r', ',', ']', '}']).unwrap_or(rest.len());
+            Span::new(
+                id,
+                sp.start as usize,
+                sp.start as usize + rest[..len].trim_end().len(),
+            )
+        } else {
+            sp
+        }
+    };
+    if file
+        .text
+        .lines()
+        .all(|l| l.trim().is_empty() || l.trim_start().starts_with('#'))
+    {
+        return Ok(Manifest::default());
+    }
+    let options = serde_saphyr::options! { with_snippet: false };
+    let raw: Raw = match serde_saphyr::from_str_with_options(&file.text, options) {
+        Ok(raw) => raw,
+        Err(e) => {
+            let span = match e.location() {
+                Some(loc) => spanned(&loc),
+                None => Span::new(id, 0, 0),
+            };
+            let message = first_line(&e.to_string());
+            return Err(vec![Diagnostic::error(
+                Code::Manifest,
+                format!("invalid `rcs.yaml`: {message}"),
+                span,
+                "here",
+            )
+            .with_help(
+                "known keys: system, plans, limits {max_rules_per_plan, max_subordinates}, \
+                 lints {LINT: allow|warn|deny}, schedule [{cpu, period, order}]",
+            )]);
+        }
+    };
+
+    let mut diags = Vec::new();
+    let mut m = Manifest {
+        system: raw
+            .system
+            .map(|s| (s.value.clone(), spanned(&s.referenced))),
+        plans: raw.plans.map(|ps| {
+            ps.iter()
+                .map(|p| (p.value.clone(), spanned(&p.referenced)))
+                .collect()
+        }),
+        ..Manifest::default()
+    };
+    if let Some((name, span)) = &m.system {
+        if !is_identifier(name) {
+            diags.push(
+                Diagnostic::error(
+                    Code::Manifest,
+                    format!("system name `{name}` is not an identifier"),
+                    *span,
+                    "used as a Rust module name",
+                )
+                .with_help("use letters, digits and `_`, not starting with a digit"),
+            );
+        }
+    }
+    if let Some(limits) = raw.limits {
+        if let Some(v) = limits.max_rules_per_plan {
+            m.limits.max_rules_per_plan = v.value;
+        }
+        if let Some(v) = limits.max_subordinates {
+            m.limits.max_subordinates = v.value;
+        }
+    }
+    for (name, level) in raw.lints.into_iter().flatten() {
+        let span = spanned(&level.referenced);
+        match (Lint::from_name(&name), Level::from_name(&level.value)) {
+            (Some(lint), Some(lv)) => m.lints.push((lint, lv)),
+            (None, _) => diags.push(
+                Diagnostic::error(
+                    Code::Manifest,
+                    format!("unknown lint `{name}` in `lints`"),
+                    span,
+                    "this lint's level",
+                )
+                .with_help(format!(
+                    "the lints are: {}",
+                    Lint::ALL.map(Lint::name).join(", ")
+                )),
+            ),
+            (Some(_), None) => diags.push(Diagnostic::error(
+                Code::Manifest,
+                format!("unknown lint level `{}`", level.value),
+                span,
+                "expected `allow`, `warn` or `deny`",
+            )),
+        }
+    }
+    if let Some(schedule) = raw.schedule {
+        m.schedule_span = Some(spanned(&schedule.referenced));
+        let mut cpus = Vec::new();
+        for cpu in schedule.value {
+            let span = spanned(&cpu.cpu.referenced);
+            let period_ns = match &cpu.period {
+                None => DEFAULT_PERIOD_NS,
+                Some(p) => match parse_duration(&p.value) {
+                    Some(ns) if ns > 0 => ns,
+                    _ => {
+                        diags.push(
+                            Diagnostic::error(
+                                Code::Manifest,
+                                format!("bad period `{}`", p.value),
+                                spanned(&p.referenced),
+                                "not a duration",
+                            )
+                            .with_help("write a positive number with a unit: `30ms`, `500us`, `1s`, `250000ns`"),
+                        );
+                        DEFAULT_PERIOD_NS
+                    }
+                },
+            };
+            if cpus.iter().any(|c: &CpuSpec| c.name == cpu.cpu.value) {
+                diags.push(Diagnostic::error(
+                    Code::Manifest,
+                    format!("CPU `{}` is scheduled twice", cpu.cpu.value),
+                    span,
+                    "second entry for this CPU",
+                ));
+            }
+            cpus.push(CpuSpec {
+                name: cpu.cpu.value.clone(),
+                span,
+                period_ns,
+                order: cpu
+                    .order
+                    .iter()
+                    .map(|o| (o.value.clone(), spanned(&o.referenced)))
+                    .collect(),
+            });
+        }
+        m.schedule = Some(cpus);
+    }
+    if diags.is_empty() {
+        Ok(m)
+    } else {
+        Err(diags)
+    }
+}
+
+/// `30ms`, `1.5s`, `500us`/`500µs`, `100ns`, in nanoseconds.
+pub fn parse_duration(text: &str) -> Option<u64> {
+    let text = text.trim();
+    let split = text.find(|c: char| !(c.is_ascii_digit() || c == '.'))?;
+    let (num, unit) = text.split_at(split);
+    let scale: f64 = match unit.trim() {
+        "ns" => 1.0,
+        "us" | "µs" => 1e3,
+        "ms" => 1e6,
+        "s" => 1e9,
+        _ => return None,
+    };
+    let v: f64 = num.parse().ok()?;
+    let ns = v * scale;
+    (ns.is_finite() && ns >= 1.0 && ns < 1e18).then_some(ns.round() as u64)
+}
+
+fn is_identifier(s: &str) -> bool {
+    let mut chars = s.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+fn first_line(s: &str) -> String {
+    s.lines().next().unwrap_or("").trim().to_string()
+}
+
+fn offset_of(file: &SourceFile, line: u64, column: u64) -> usize {
+    let starts = file.line_starts();
+    let Some(&start) = starts.get((line as usize).saturating_sub(1)) else {
+        return file.text.len();
+    };
+    let rest = &file.text[start..];
+    start
+        + rest
+            .char_indices()
+            .nth((column as usize).saturating_sub(1))
+            .map(|(i, _)| i)
+            .unwrap_or(rest.len())
+}

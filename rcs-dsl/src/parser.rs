@@ -1,0 +1,934 @@
+//! Stage 1 of the pipeline: text → [`ast::File`]. pest does the matching;
+//! this module turns its pairs into the AST and its failures into `syntax`
+//! diagnostics phrased in the user's words.
+//!
+//! Hostile input is bounded here: a size limit, a bracket-nesting limit
+//! checked before pest runs (so no input can exhaust the stack), and an
+//! expression-depth limit while folding operator chains.
+
+use crate::ast::*;
+use crate::diagnostic::{Code, Diagnostic};
+use crate::lint::{Level, Lint};
+use crate::source::{FileId, Span};
+use pest::iterators::Pair;
+use pest::Parser as _;
+
+#[derive(pest_derive::Parser)]
+#[grammar = "grammar.pest"]
+struct RcsParser;
+
+/// Largest accepted source file.
+pub const MAX_FILE_BYTES: usize = 16 * 1024 * 1024;
+/// Deepest accepted nesting of `(`, `[` and `{`.
+pub const MAX_NESTING: usize = 64;
+/// Deepest accepted expression tree (operator chains count one level per operator).
+pub const MAX_EXPR_DEPTH: usize = 256;
+
+/// Parse one file. On failure, returns its `syntax` diagnostics.
+pub fn parse_file(file: FileId, text: &str) -> Result<File, Vec<Diagnostic>> {
+    if text.len() > MAX_FILE_BYTES {
+        return Err(vec![Diagnostic::error(
+            Code::Syntax,
+            format!(
+                "file is too large ({} bytes; the limit is {} bytes)",
+                text.len(),
+                MAX_FILE_BYTES
+            ),
+            Span::new(file, 0, 0),
+            "this file",
+        )
+        .with_help("split the plan set into smaller files")]);
+    }
+    check_nesting(file, text)?;
+    let pairs = match RcsParser::parse(Rule::file, text) {
+        Ok(mut pairs) => pairs.next().expect("the file rule always yields one pair"),
+        Err(e) => {
+            // Tracking every token tried costs time, so only a failed parse
+            // runs again with it, to say which punctuation was expected.
+            pest::set_error_detail(true);
+            let detailed = RcsParser::parse(Rule::file, text).err();
+            pest::set_error_detail(false);
+            return Err(vec![syntax_error(file, text, detailed.unwrap_or(e))]);
+        }
+    };
+    let mut builder = Builder {
+        file,
+        diags: Vec::new(),
+    };
+    let mut out = File::default();
+    for p in pairs.into_inner() {
+        if p.as_rule() == Rule::item {
+            if let Some(item) = builder.item(p) {
+                out.items.push(item);
+            }
+        }
+    }
+    if builder.diags.is_empty() {
+        Ok(out)
+    } else {
+        Err(builder.diags)
+    }
+}
+
+/// Reject bracket nesting deeper than [`MAX_NESTING`] before pest sees the
+/// text, skipping comments and strings the way the grammar does.
+fn check_nesting(file: FileId, text: &str) -> Result<(), Vec<Diagnostic>> {
+    let bytes = text.as_bytes();
+    let mut depth = 0usize;
+    let mut i = 0;
+    while i < bytes.len() {
+        match bytes[i] {
+            b'/' if bytes.get(i + 1) == Some(&b'/') => {
+                while i < bytes.len() && bytes[i] != b'\n' {
+                    i += 1;
+                }
+            }
+            b'/' if bytes.get(i + 1) == Some(&b'*') => {
+                i += 2;
+                while i < bytes.len() && !(bytes[i] == b'*' && bytes.get(i + 1) == Some(&b'/')) {
+                    i += 1;
+                }
+                i += 1;
+            }
+            b'"' => {
+                i += 1;
+                while i < bytes.len() && bytes[i] != b'"' && bytes[i] != b'\n' {
+                    if bytes[i] == b'\\' {
+                        i += 1;
+                    }
+                    i += 1;
+                }
+            }
+            b'(' | b'[' | b'{' => {
+                depth += 1;
+                if depth > MAX_NESTING {
+                    return Err(vec![Diagnostic::error(
+                        Code::Syntax,
+                        format!("brackets nested more than {MAX_NESTING} deep"),
+                        Span::new(file, i, i + 1),
+                        "nesting limit reached here",
+                    )
+                    .with_help("split the expression with a `var` or a hook")]);
+                }
+            }
+            b')' | b']' | b'}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+        i += 1;
+    }
+    Ok(())
+}
+
+/// Turn a pest failure into one diagnostic: where, what was expected, what was found.
+fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>) -> Diagnostic {
+    use pest::error::{ErrorVariant, InputLocation};
+    let pos = match e.location {
+        InputLocation::Pos(p) => p,
+        InputLocation::Span((s, _)) => s,
+    };
+    let mut expected: Vec<String> = Vec::new();
+    let mut add = |s: String| {
+        if !expected.contains(&s) {
+            expected.push(s);
+        }
+    };
+    match &e.variant {
+        ErrorVariant::ParsingError { positives, .. } => {
+            for r in positives {
+                if let Some(w) = rule_words(*r) {
+                    add(w.to_string());
+                }
+            }
+        }
+        ErrorVariant::CustomError { message } => {
+            // pest's own limits ("call limit reached", "stack limit reached").
+            return Diagnostic::error(
+                Code::Syntax,
+                format!("input too complex to parse: {message}"),
+                Span::new(file, pos, pos),
+                "parsing stopped here",
+            );
+        }
+    }
+    if let Some(attempts) = e.parse_attempts() {
+        for t in attempts.expected_tokens() {
+            // The token type is not exported; its Display is the literal text.
+            if let Some(w) = token_words(&t.to_string()) {
+                add(w);
+            }
+        }
+    }
+    // `(` and `[` can start an expression; saying both is noise.
+    if expected.iter().any(|w| w == "an expression") {
+        expected.retain(|w| w != "`(`" && w != "`[`");
+    }
+    let found = describe_found(text, pos);
+    let end = found_end(text, pos);
+    let message = if expected.is_empty() {
+        format!("unexpected {found}")
+    } else {
+        format!("expected {}, found {found}", one_of(&expected))
+    };
+    Diagnostic::error(
+        Code::Syntax,
+        message,
+        Span::new(file, pos, end),
+        if expected.is_empty() {
+            "unexpected here".to_string()
+        } else {
+            format!("expected {}", one_of(&expected))
+        },
+    )
+}
+
+fn one_of(words: &[String]) -> String {
+    match words {
+        [] => String::new(),
+        [a] => a.clone(),
+        [a, b] => format!("{a} or {b}"),
+        [rest @ .., last] => format!("{}, or {last}", rest.join(", ")),
+    }
+}
+
+/// What a named rule means to a user, or `None` for rules that never help.
+fn rule_words(rule: Rule) -> Option<&'static str> {
+    Some(match rule {
+        Rule::EOI => "end of file",
+        Rule::item => "an item (`enum`, `buffer` or `controller`)",
+        Rule::doc_comment => return None,
+        Rule::attribute => "an attribute `#[…]`",
+        Rule::ident | Rule::path => "a name",
+        Rule::int_lit => "an integer",
+        Rule::float_lit => "a number",
+        Rule::bool_lit => "`true` or `false`",
+        Rule::string_lit => "a title string",
+        Rule::type_expr | Rule::array_type => "a type",
+        Rule::variant => "a variant name",
+        Rule::field => "a field",
+        Rule::entry => "a controller entry (`command`, `plan`, `reads`, …)",
+        Rule::param | Rule::named_arg => "a parameter",
+        Rule::row => "a row",
+        Rule::row_label => "a row label `EN`",
+        Rule::from_state => "a state or `*`",
+        Rule::dont_care => "`*`",
+        Rule::target => "a target (a state, `same`, `Done` or `Error(…)`)",
+        Rule::error_target | Rule::error_word => "`Error`",
+        Rule::jobs => "a job list `{ … }`",
+        Rule::job | Rule::send_job | Rule::report_job | Rule::expr_job => "a job",
+        Rule::assign_op => "`=`, `+=` or `-=`",
+        Rule::send_arrow => "`<-`",
+        Rule::arrow => "`->`",
+        Rule::expr
+        | Rule::or_expr
+        | Rule::and_expr
+        | Rule::cmp_expr
+        | Rule::add_expr
+        | Rule::mul_expr
+        | Rule::unary_expr
+        | Rule::cast_expr
+        | Rule::postfix_expr
+        | Rule::primary
+        | Rule::paren
+        | Rule::call
+        | Rule::cmd_param => "an expression",
+        Rule::op_or | Rule::op_and | Rule::op_cmp | Rule::op_add | Rule::op_mul => "an operator",
+        Rule::op_unary => "an expression",
+        Rule::field_access => "`.`",
+        Rule::index => "`[`",
+        Rule::lint_level => "`allow`, `warn` or `deny`",
+        Rule::kw_when => "`when`",
+        Rule::kw_otherwise => "`otherwise`",
+        Rule::kw_as => "`as`",
+        Rule::kw_same => "`same`",
+        Rule::kw_cmd => "`cmd`",
+        Rule::kw_new_command => "`new_command`",
+        Rule::kw_report => "`report`",
+        _ => return None,
+    })
+}
+
+/// Literal tokens pest tried at the failure point, as the user writes them.
+fn token_words(token: &str) -> Option<String> {
+    match token {
+        "{" | "}" | "(" | ")" | "[" | "]" | ":" | ";" | "," | "->" | "=" | "::" | "." | "#" => {
+            Some(format!("`{token}`"))
+        }
+        _ => None,
+    }
+}
+
+fn describe_found(text: &str, pos: usize) -> String {
+    let rest = &text[pos.min(text.len())..];
+    match rest.chars().next() {
+        None => "end of file".to_string(),
+        Some(c) if c.is_ascii_alphanumeric() || c == '_' => {
+            let word: String = rest
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .take(40)
+                .collect();
+            format!("`{word}`")
+        }
+        Some('\n') | Some('\r') => "end of line".to_string(),
+        Some(c) if c.is_control() => format!("character U+{:04X}", c as u32),
+        Some(c) => format!("`{c}`"),
+    }
+}
+
+fn found_end(text: &str, pos: usize) -> usize {
+    let rest = &text[pos.min(text.len())..];
+    match rest.chars().next() {
+        None | Some('\n') | Some('\r') => pos,
+        Some(c) if c.is_ascii_alphanumeric() || c == '_' => {
+            pos + rest
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .count()
+        }
+        Some(c) => pos + c.len_utf8(),
+    }
+}
+
+/// Builds AST nodes from pairs, collecting the few syntax errors the grammar
+/// leaves to it (attributes in the wrong place, limits, bad numbers).
+struct Builder {
+    file: FileId,
+    diags: Vec<Diagnostic>,
+}
+
+impl Builder {
+    fn span(&self, p: &Pair<Rule>) -> Span {
+        let s = p.as_span();
+        Span::new(self.file, s.start(), s.end())
+    }
+
+    fn name(&self, p: Pair<Rule>) -> Name {
+        Name {
+            text: p.as_str().to_string(),
+            span: self.span(&p),
+        }
+    }
+
+    fn error(&mut self, span: Span, message: impl Into<String>, label: impl Into<String>) {
+        self.diags
+            .push(Diagnostic::error(Code::Syntax, message, span, label));
+    }
+
+    fn int(&mut self, p: Pair<Rule>) -> u64 {
+        let span = self.span(&p);
+        match p.as_str().replace('_', "").parse::<u64>() {
+            Ok(v) => v,
+            Err(_) => {
+                self.error(
+                    span,
+                    "integer literal is too large",
+                    "does not fit in 64 bits",
+                );
+                0
+            }
+        }
+    }
+
+    fn doc(p: &Pair<Rule>) -> String {
+        let s = p.as_str().trim_start_matches("///");
+        s.strip_prefix(' ').unwrap_or(s).trim_end().to_string()
+    }
+
+    fn outer(&mut self, pairs: &mut Vec<Pair<Rule>>) -> Outer {
+        let mut outer = Outer::default();
+        for p in pairs.drain(..) {
+            match p.as_rule() {
+                Rule::doc_comment => outer.docs.push(Self::doc(&p)),
+                Rule::attribute => {
+                    let mut inner = p.into_inner();
+                    let level = inner.next().expect("attribute has a level");
+                    let level = Level::from_name(level.as_str()).expect("grammar limits levels");
+                    for name in inner {
+                        let span = self.span(&name);
+                        match Lint::from_name(name.as_str()) {
+                            Some(lint) => outer.lints.push(((lint, level), span)),
+                            None => self.diags.push(
+                                Diagnostic::error(
+                                    Code::UnknownName,
+                                    format!("unknown lint `{}`", name.as_str()),
+                                    span,
+                                    "not a lint",
+                                )
+                                .with_help(format!(
+                                    "the lints are: {}",
+                                    Lint::ALL.map(Lint::name).join(", ")
+                                )),
+                            ),
+                        }
+                    }
+                }
+                _ => unreachable!("outer holds only docs and attributes"),
+            }
+        }
+        outer
+    }
+
+    /// Split leading docs/attributes from the rest of a pair's children.
+    fn split_outer<'i>(&mut self, p: Pair<'i, Rule>) -> (Outer, Vec<Pair<'i, Rule>>) {
+        let mut lead = Vec::new();
+        let mut rest = Vec::new();
+        for c in p.into_inner() {
+            if rest.is_empty() && matches!(c.as_rule(), Rule::doc_comment | Rule::attribute) {
+                lead.push(c);
+            } else {
+                rest.push(c);
+            }
+        }
+        (self.outer(&mut lead), rest)
+    }
+
+    fn no_attributes(&mut self, outer: &Outer, what: &str) {
+        for (_, span) in &outer.lints {
+            self.error(
+                *span,
+                format!("lint attributes cannot stand before {what}"),
+                "attribute not allowed here",
+            );
+            self.diags.last_mut().expect("just pushed").help =
+                Some("put it before the controller or the plan".to_string());
+        }
+    }
+
+    fn item(&mut self, p: Pair<Rule>) -> Option<Item> {
+        let (outer, mut rest) = self.split_outer(p);
+        let def = rest.pop()?;
+        let span = self.span(&def);
+        let mut inner = def.clone().into_inner();
+        Some(match def.as_rule() {
+            Rule::enum_def => {
+                inner.next(); // kw
+                let name = self.name(inner.next()?);
+                let variants = inner
+                    .map(|v| {
+                        let mut docs = Vec::new();
+                        let mut name = None;
+                        for c in v.into_inner() {
+                            match c.as_rule() {
+                                Rule::doc_comment => docs.push(Self::doc(&c)),
+                                _ => name = Some(self.name(c)),
+                            }
+                        }
+                        (docs, name.expect("variant has a name"))
+                    })
+                    .collect();
+                Item::Enum(EnumDef {
+                    outer,
+                    name,
+                    variants,
+                    span,
+                })
+            }
+            Rule::buffer_def => {
+                inner.next();
+                let name = self.name(inner.next()?);
+                let fields = inner.map(|f| self.field(f)).collect();
+                Item::Buffer(BufferDef {
+                    outer,
+                    name,
+                    fields,
+                    span,
+                })
+            }
+            Rule::controller_def => {
+                inner.next();
+                let name = self.name(inner.next()?);
+                let mut title = None;
+                let mut entries = Vec::new();
+                for c in inner {
+                    match c.as_rule() {
+                        Rule::string_lit => {
+                            let s = c.as_str();
+                            title = Some(unescape(&s[1..s.len() - 1]));
+                        }
+                        Rule::entry => {
+                            if let Some(e) = self.entry(c) {
+                                entries.push(e);
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+                Item::Controller(ControllerDef {
+                    outer,
+                    name,
+                    title,
+                    entries,
+                    span,
+                })
+            }
+            _ => return None,
+        })
+    }
+
+    fn field(&mut self, p: Pair<Rule>) -> Field {
+        let mut docs = Vec::new();
+        let mut name = None;
+        let mut ty = None;
+        for c in p.into_inner() {
+            match c.as_rule() {
+                Rule::doc_comment => docs.push(Self::doc(&c)),
+                Rule::ident => name = Some(self.name(c)),
+                Rule::type_expr => ty = Some(self.type_expr(c)),
+                _ => {}
+            }
+        }
+        Field {
+            docs,
+            name: name.expect("field has a name"),
+            ty: ty.expect("field has a type"),
+        }
+    }
+
+    fn type_expr(&mut self, p: Pair<Rule>) -> TypeExpr {
+        let c = p.into_inner().next().expect("type_expr has one child");
+        match c.as_rule() {
+            Rule::array_type => {
+                let span = self.span(&c);
+                let mut inner = c.into_inner();
+                let elem = self.type_expr(inner.next().expect("element type"));
+                let len = self.int(inner.next().expect("array length"));
+                TypeExpr::Array {
+                    elem: Box::new(elem),
+                    len,
+                    span,
+                }
+            }
+            _ => TypeExpr::Named(self.name(c)),
+        }
+    }
+
+    fn params<'i>(&mut self, pairs: impl Iterator<Item = Pair<'i, Rule>>) -> Vec<Param> {
+        pairs
+            .filter(|p| p.as_rule() == Rule::param)
+            .map(|p| {
+                let mut inner = p.into_inner();
+                let name = self.name(inner.next().expect("param name"));
+                let ty = self.type_expr(inner.next().expect("param type"));
+                Param { name, ty }
+            })
+            .collect()
+    }
+
+    fn entry(&mut self, p: Pair<Rule>) -> Option<Entry> {
+        let span = self.span(&p);
+        let (outer, mut rest) = self.split_outer(p);
+        let decl = rest.pop()?;
+        let rule = decl.as_rule();
+        if rule != Rule::plan_def {
+            self.no_attributes(&outer, "this entry");
+        }
+        let mut inner = decl.clone().into_inner();
+        inner.next(); // the keyword
+        let kind = match rule {
+            Rule::level_decl => {
+                let n = inner.next()?;
+                let s = self.span(&n);
+                EntryKind::Level(self.int(n), s)
+            }
+            Rule::subordinates_decl => {
+                EntryKind::Subordinates(inner.map(|n| self.name(n)).collect())
+            }
+            Rule::reads_decl | Rule::writes_decl => {
+                let name = self.name(inner.next()?);
+                let ty = self.name(inner.next()?);
+                if rule == Rule::reads_decl {
+                    EntryKind::Reads(name, ty)
+                } else {
+                    EntryKind::Writes(name, ty)
+                }
+            }
+            Rule::command_decl => {
+                let name = self.name(inner.next()?);
+                EntryKind::Command(name, self.params(inner))
+            }
+            Rule::status_decl => EntryKind::Status(inner.map(|n| self.name(n)).collect()),
+            Rule::error_decl => EntryKind::Error(inner.map(|n| self.name(n)).collect()),
+            Rule::var_decl => {
+                let name = self.name(inner.next()?);
+                let ty = self.type_expr(inner.next()?);
+                let init = inner.next().map(|e| self.expr(e));
+                EntryKind::Var { name, ty, init }
+            }
+            Rule::hook_decl => {
+                let name = self.name(inner.next()?);
+                let mut params = Vec::new();
+                let mut ret = None;
+                for c in inner {
+                    match c.as_rule() {
+                        Rule::param => params.extend(self.params(std::iter::once(c))),
+                        Rule::type_expr => ret = Some(self.type_expr(c)),
+                        _ => {}
+                    }
+                }
+                EntryKind::Hook { name, params, ret }
+            }
+            Rule::plan_def => {
+                let kw = decl.clone().into_inner().next()?;
+                let verb_pair = inner.next()?;
+                let header = self.span(&kw).to(self.span(&verb_pair));
+                let verb = self.name(verb_pair);
+                let rows = inner.map(|r| self.row(r)).collect();
+                EntryKind::Plan(PlanDef { verb, header, rows })
+            }
+            _ => return None,
+        };
+        Some(Entry { outer, kind, span })
+    }
+
+    fn row(&mut self, p: Pair<Rule>) -> Row {
+        let span = self.span(&p);
+        let mut docs = Vec::new();
+        let mut label = None;
+        let mut body = None;
+        for c in p.into_inner() {
+            match c.as_rule() {
+                Rule::doc_comment => docs.push(Self::doc(&c)),
+                Rule::row_label => {
+                    let s = self.span(&c);
+                    let n = c.as_str()[1..].parse::<u64>().unwrap_or(u64::MAX);
+                    label = Some((n, s));
+                }
+                _ => body = Some(c),
+            }
+        }
+        let body = body.expect("row has a body");
+        let otherwise = body.as_rule() == Rule::otherwise_row;
+        let mut from = From::Implicit;
+        let mut cond = None;
+        let mut cond_span = span;
+        let mut target = None;
+        let mut jobs = Vec::new();
+        for c in body.into_inner() {
+            match c.as_rule() {
+                Rule::dont_care => from = self.dont_care(c),
+                Rule::from_state => {
+                    let c = c.into_inner().next().expect("from has one child");
+                    from = match c.as_rule() {
+                        Rule::dont_care => self.dont_care(c),
+                        _ => From::State(self.name(c)),
+                    };
+                }
+                Rule::kw_otherwise => cond_span = self.span(&c),
+                Rule::expr => {
+                    cond_span = self.span(&c);
+                    cond = Some(self.expr(c));
+                }
+                Rule::target => target = Some(self.target(c)),
+                Rule::jobs => jobs = c.into_inner().map(|j| self.job(j)).collect(),
+                _ => {}
+            }
+        }
+        debug_assert!(otherwise == cond.is_none());
+        Row {
+            docs,
+            label,
+            from,
+            cond,
+            cond_span,
+            target: target.expect("row has a target"),
+            jobs,
+            span,
+        }
+    }
+
+    fn dont_care(&mut self, p: Pair<Rule>) -> From {
+        let span = self.span(&p);
+        let digits = &p.as_str()[1..];
+        let n = if digits.is_empty() {
+            None
+        } else {
+            Some(digits.parse::<u64>().unwrap_or(u64::MAX))
+        };
+        From::DontCare(n, span)
+    }
+
+    fn target(&mut self, p: Pair<Rule>) -> Target {
+        let c = p.into_inner().next().expect("target has one child");
+        let span = self.span(&c);
+        match c.as_rule() {
+            Rule::kw_same => Target::Same(span),
+            Rule::error_target => {
+                let code = c.into_inner().nth(1).map(|n| self.name(n));
+                Target::Error(code, span)
+            }
+            _ => Target::State(self.name(c)),
+        }
+    }
+
+    fn job(&mut self, p: Pair<Rule>) -> Job {
+        let c = p.into_inner().next().expect("job has one child");
+        let span = self.span(&c);
+        match c.as_rule() {
+            Rule::send_job => {
+                let mut inner = c.into_inner();
+                let sub = self.name(inner.next().expect("subordinate"));
+                inner.next(); // <-
+                let verb = self.name(inner.next().expect("verb"));
+                let args = inner
+                    .map(|a| {
+                        let mut ai = a.into_inner();
+                        let n = self.name(ai.next().expect("arg name"));
+                        let e = self.expr(ai.next().expect("arg value"));
+                        (n, e)
+                    })
+                    .collect();
+                Job::Send {
+                    sub,
+                    verb,
+                    args,
+                    span,
+                }
+            }
+            Rule::report_job => {
+                let n = self.name(c.into_inner().nth(1).expect("status"));
+                Job::Report(n, span)
+            }
+            _ => {
+                let mut inner = c.into_inner();
+                let place = self.postfix(inner.next().expect("place"), 0);
+                match inner.next() {
+                    Some(op) => {
+                        let op = match op.as_str() {
+                            "+=" => AssignOp::Add,
+                            "-=" => AssignOp::Sub,
+                            _ => AssignOp::Set,
+                        };
+                        let value = self.expr(inner.next().expect("assigned value"));
+                        Job::Assign {
+                            place,
+                            op,
+                            value,
+                            span,
+                        }
+                    }
+                    None => {
+                        if !matches!(place.kind, ExprKind::Call(..)) {
+                            self.error(
+                                span,
+                                "expected a job: an assignment, `X <- VERB`, `report S` or a hook call",
+                                "this expression does nothing",
+                            );
+                        }
+                        Job::Call(place)
+                    }
+                }
+            }
+        }
+    }
+
+    fn expr(&mut self, p: Pair<Rule>) -> Expr {
+        self.expr_at(p, 0)
+    }
+
+    /// Build an expression at tree depth `depth`, enforcing [`MAX_EXPR_DEPTH`].
+    fn expr_at(&mut self, p: Pair<Rule>, depth: usize) -> Expr {
+        let span = self.span(&p);
+        if depth > MAX_EXPR_DEPTH {
+            self.error(
+                span,
+                format!("expression nested more than {MAX_EXPR_DEPTH} deep"),
+                "too deep",
+            );
+            return Expr {
+                kind: ExprKind::Bool(false),
+                span,
+            };
+        }
+        match p.as_rule() {
+            // `expr` is the grammar's entry point, not a user's parenthesis.
+            Rule::expr => self.expr_at(p.into_inner().next().expect("one child"), depth),
+            Rule::or_expr | Rule::and_expr | Rule::cmp_expr | Rule::add_expr | Rule::mul_expr => {
+                let mut inner = p.into_inner();
+                let first = inner.next().expect("operand");
+                let mut rest: Vec<(BinOp, Pair<Rule>)> = Vec::new();
+                while let Some(op) = inner.next() {
+                    let rhs = inner.next().expect("right operand");
+                    rest.push((bin_op(op.as_str()), rhs));
+                }
+                if rest.len() + depth > MAX_EXPR_DEPTH {
+                    return self.expr_at(first, MAX_EXPR_DEPTH + 1);
+                }
+                let n = rest.len();
+                let mut lhs = self.expr_at(first, depth + n);
+                for (i, (op, rhs)) in rest.into_iter().enumerate() {
+                    let rhs = self.expr_at(rhs, depth + n - i);
+                    let span = lhs.span.to(rhs.span);
+                    lhs = Expr {
+                        kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
+                        span,
+                    };
+                }
+                lhs
+            }
+            Rule::unary_expr => {
+                let mut ops = Vec::new();
+                let mut operand = None;
+                for c in p.into_inner() {
+                    match c.as_rule() {
+                        Rule::op_unary => ops.push((c.as_str() == "!", self.span(&c))),
+                        _ => operand = Some(c),
+                    }
+                }
+                if ops.len() + depth > MAX_EXPR_DEPTH {
+                    return self.expr_at(operand.expect("operand"), MAX_EXPR_DEPTH + 1);
+                }
+                let mut e = self.expr_at(operand.expect("operand"), depth + ops.len());
+                for (not, op_span) in ops.into_iter().rev() {
+                    let span = op_span.to(e.span);
+                    let op = if not { UnOp::Not } else { UnOp::Neg };
+                    e = Expr {
+                        kind: ExprKind::Unary(op, Box::new(e)),
+                        span,
+                    };
+                }
+                e
+            }
+            Rule::cast_expr => {
+                let mut inner = p.into_inner();
+                let first = inner.next().expect("operand");
+                let types: Vec<Name> = inner
+                    .filter(|c| c.as_rule() == Rule::ident)
+                    .map(|c| self.name(c))
+                    .collect();
+                if types.len() + depth > MAX_EXPR_DEPTH {
+                    return self.expr_at(first, MAX_EXPR_DEPTH + 1);
+                }
+                let mut e = self.postfix(first, depth + types.len());
+                for ty in types {
+                    let span = e.span.to(ty.span);
+                    e = Expr {
+                        kind: ExprKind::Cast(Box::new(e), ty),
+                        span,
+                    };
+                }
+                e
+            }
+            Rule::postfix_expr => self.postfix(p, depth),
+            _ => self.primary(p, depth),
+        }
+    }
+
+    fn postfix(&mut self, p: Pair<Rule>, depth: usize) -> Expr {
+        let mut inner = p.into_inner();
+        let first = inner.next().expect("primary");
+        let suffixes: Vec<Pair<Rule>> = inner.collect();
+        if suffixes.len() + depth > MAX_EXPR_DEPTH {
+            return self.expr_at(first, MAX_EXPR_DEPTH + 1);
+        }
+        let mut e = self.primary(first, depth + suffixes.len());
+        for s in suffixes {
+            let sspan = self.span(&s);
+            let span = e.span.to(sspan);
+            let c = s.into_inner().next().expect("suffix has one child");
+            e = match c.as_rule() {
+                Rule::ident | Rule::kw_status | Rule::kw_error => Expr {
+                    kind: ExprKind::Field(Box::new(e), self.name(c)),
+                    span,
+                },
+                _ => {
+                    let idx = self.expr_at(c, depth + 1);
+                    Expr {
+                        kind: ExprKind::Index(Box::new(e), Box::new(idx)),
+                        span,
+                    }
+                }
+            };
+        }
+        e
+    }
+
+    fn primary(&mut self, p: Pair<Rule>, depth: usize) -> Expr {
+        let p = if p.as_rule() == Rule::primary {
+            p.into_inner().next().expect("primary has one child")
+        } else {
+            p
+        };
+        let span = self.span(&p);
+        let kind = match p.as_rule() {
+            Rule::float_lit => match p.as_str().replace('_', "").parse::<f64>() {
+                Ok(v) if v.is_finite() => ExprKind::Float(v),
+                _ => {
+                    self.error(span, "float literal is out of range", "not a finite f64");
+                    ExprKind::Float(0.0)
+                }
+            },
+            Rule::int_lit => match p.as_str().replace('_', "").parse::<u128>() {
+                Ok(v) if v <= u64::MAX as u128 => ExprKind::Int(v),
+                _ => {
+                    self.error(
+                        span,
+                        "integer literal is too large",
+                        "does not fit in 64 bits",
+                    );
+                    ExprKind::Int(0)
+                }
+            },
+            Rule::bool_lit => ExprKind::Bool(p.as_str() == "true"),
+            Rule::kw_new_command => ExprKind::NewCommand,
+            Rule::kw_state_cycles => ExprKind::StateCycles,
+            Rule::kw_plan_cycles => ExprKind::PlanCycles,
+            Rule::cmd_param => {
+                let n = p.into_inner().nth(1).expect("parameter name");
+                ExprKind::CmdParam(self.name(n))
+            }
+            Rule::call => {
+                let mut inner = p.into_inner();
+                let name = self.name(inner.next().expect("hook name"));
+                let args = inner.map(|a| self.expr_at(a, depth + 1)).collect();
+                ExprKind::Call(name, args)
+            }
+            Rule::path => {
+                let mut names: Vec<Name> = p.into_inner().map(|n| self.name(n)).collect();
+                let last = names.pop().expect("path has a name");
+                ExprKind::Path(names.pop(), last)
+            }
+            Rule::paren => {
+                let e = self.expr_at(p.into_inner().next().expect("inner"), depth + 1);
+                ExprKind::Paren(Box::new(e))
+            }
+            _ => return self.expr_at(p, depth),
+        };
+        Expr { kind, span }
+    }
+}
+
+fn bin_op(s: &str) -> BinOp {
+    match s {
+        "||" => BinOp::Or,
+        "&&" => BinOp::And,
+        "==" => BinOp::Eq,
+        "!=" => BinOp::Ne,
+        "<" => BinOp::Lt,
+        "<=" => BinOp::Le,
+        ">" => BinOp::Gt,
+        ">=" => BinOp::Ge,
+        "+" => BinOp::Add,
+        "-" => BinOp::Sub,
+        "*" => BinOp::Mul,
+        "/" => BinOp::Div,
+        _ => BinOp::Rem,
+    }
+}
+
+fn unescape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    let mut chars = s.chars();
+    while let Some(c) = chars.next() {
+        if c == '\\' {
+            match chars.next() {
+                Some('n') => out.push('\n'),
+                Some('t') => out.push('\t'),
+                Some(other) => out.push(other),
+                None => {}
+            }
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}

@@ -1,0 +1,209 @@
+//! The last step for diagnostics: text for people and machines. The library
+//! renders to strings; only the CLI (or build.rs `Config`) prints them.
+//!
+//! - `human`: rustc-like snippets (codespan-reporting), colour optional;
+//! - `short`: one `file:line:col: severity[code]: message` line;
+//! - `json`: one object per line (see [`json`]).
+
+use crate::diagnostic::{Diagnostic, Severity};
+use crate::source::{FileId, SourceMap, Span};
+use codespan_reporting::diagnostic as cs;
+use codespan_reporting::files::{Error as FilesError, Files};
+use codespan_reporting::term;
+use serde::Serialize;
+use std::ops::Range;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    Human { color: bool },
+    Short,
+    Json,
+}
+
+/// Render one diagnostic, ending with a newline.
+pub fn render(d: &Diagnostic, sources: &SourceMap, format: Format) -> String {
+    match format {
+        Format::Human { color } => human(d, sources, color),
+        Format::Short => short(d, sources),
+        Format::Json => {
+            let mut s = serde_json::to_string(&json(d, sources)).expect("diagnostics serialise");
+            s.push('\n');
+            s
+        }
+    }
+}
+
+/// `N errors, M warnings` style summary; `None` when there is nothing to say.
+pub fn summary(errors: usize, warnings: usize) -> Option<String> {
+    let plural = |n: usize, w: &str| format!("{n} {w}{}", if n == 1 { "" } else { "s" });
+    match (errors, warnings) {
+        (0, 0) => None,
+        (0, w) => Some(format!("warning: {} emitted", plural(w, "warning"))),
+        (e, 0) => Some(format!(
+            "error: could not check the plans due to {}",
+            plural(e, "error")
+        )),
+        (e, w) => Some(format!(
+            "error: could not check the plans due to {}; {} emitted",
+            plural(e, "error"),
+            plural(w, "warning")
+        )),
+    }
+}
+
+impl<'a> Files<'a> for SourceMap {
+    type FileId = FileId;
+    type Name = &'a str;
+    type Source = &'a str;
+
+    fn name(&'a self, id: FileId) -> Result<&'a str, FilesError> {
+        Ok(&self.get(id).path)
+    }
+
+    fn source(&'a self, id: FileId) -> Result<&'a str, FilesError> {
+        Ok(&self.get(id).text)
+    }
+
+    fn line_index(&'a self, id: FileId, byte_index: usize) -> Result<usize, FilesError> {
+        Ok(self.get(id).line_col(byte_index).0 - 1)
+    }
+
+    fn line_range(&'a self, id: FileId, line_index: usize) -> Result<Range<usize>, FilesError> {
+        let f = self.get(id);
+        let starts = f.line_starts();
+        let start = *starts.get(line_index).ok_or(FilesError::LineTooLarge {
+            given: line_index,
+            max: starts.len() - 1,
+        })?;
+        let end = starts.get(line_index + 1).copied().unwrap_or(f.text.len());
+        Ok(start..end)
+    }
+}
+
+fn to_codespan(d: &Diagnostic) -> cs::Diagnostic<FileId> {
+    let severity = match d.severity {
+        Severity::Error => cs::Severity::Error,
+        Severity::Warning => cs::Severity::Warning,
+    };
+    let labels = d
+        .labels
+        .iter()
+        .map(|l| {
+            let style = if l.primary {
+                cs::LabelStyle::Primary
+            } else {
+                cs::LabelStyle::Secondary
+            };
+            cs::Label::new(style, l.span.file, l.span.range()).with_message(&l.message)
+        })
+        .collect();
+    let mut notes: Vec<String> = d.notes.iter().map(|n| format!("note: {n}")).collect();
+    if let Some(h) = &d.help {
+        notes.push(format!("help: {h}"));
+    }
+    cs::Diagnostic::new(severity)
+        .with_code(d.code.name())
+        .with_message(&d.message)
+        .with_labels(labels)
+        .with_notes(notes)
+}
+
+fn human(d: &Diagnostic, sources: &SourceMap, color: bool) -> String {
+    let config = term::Config {
+        chars: term::Chars::ascii(),
+        ..term::Config::default()
+    };
+    let diag = to_codespan(d);
+    if color {
+        let styles = term::Styles::default();
+        let mut ansi = term::termcolor::Ansi::new(Vec::new());
+        let ok = {
+            let mut w = term::StylesWriter::new(&mut ansi, &styles);
+            term::emit_to_write_style(&mut w, &config, sources, &diag).is_ok()
+        };
+        if ok {
+            return String::from_utf8_lossy(&ansi.into_inner()).into_owned();
+        }
+    }
+    term::emit_into_string(&config, sources, &diag).unwrap_or_else(|_| short(d, sources))
+}
+
+fn short(d: &Diagnostic, sources: &SourceMap) -> String {
+    let span = d.primary_span();
+    let f = sources.get(span.file);
+    let (line, col) = f.line_col(span.start as usize);
+    format!(
+        "{}:{line}:{col}: {}[{}]: {}\n",
+        f.path,
+        d.severity.as_str(),
+        d.code.name(),
+        d.message
+    )
+}
+
+/// A position in the JSON format: 1-based lines and columns (in characters).
+#[derive(Serialize)]
+pub struct JsonLabel {
+    pub file: String,
+    pub line: usize,
+    pub column: usize,
+    pub end_line: usize,
+    pub end_column: usize,
+    pub message: String,
+    pub primary: bool,
+}
+
+#[derive(Serialize)]
+pub struct JsonDiagnostic {
+    pub code: &'static str,
+    pub severity: &'static str,
+    pub message: String,
+    pub file: String,
+    pub line: usize,
+    pub column: usize,
+    pub end_line: usize,
+    pub end_column: usize,
+    pub labels: Vec<JsonLabel>,
+    pub notes: Vec<String>,
+    pub help: Option<String>,
+}
+
+fn position(sources: &SourceMap, span: Span) -> (String, usize, usize, usize, usize) {
+    let f = sources.get(span.file);
+    let (line, column) = f.line_col(span.start as usize);
+    let (end_line, end_column) = f.line_col(span.end as usize);
+    (f.path.clone(), line, column, end_line, end_column)
+}
+
+/// The JSON object of one diagnostic.
+pub fn json(d: &Diagnostic, sources: &SourceMap) -> JsonDiagnostic {
+    let (file, line, column, end_line, end_column) = position(sources, d.primary_span());
+    JsonDiagnostic {
+        code: d.code.name(),
+        severity: d.severity.as_str(),
+        message: d.message.clone(),
+        file,
+        line,
+        column,
+        end_line,
+        end_column,
+        labels: d
+            .labels
+            .iter()
+            .map(|l| {
+                let (file, line, column, end_line, end_column) = position(sources, l.span);
+                JsonLabel {
+                    file,
+                    line,
+                    column,
+                    end_line,
+                    end_column,
+                    message: l.message.clone(),
+                    primary: l.primary,
+                }
+            })
+            .collect(),
+        notes: d.notes.clone(),
+        help: d.help.clone(),
+    }
+}

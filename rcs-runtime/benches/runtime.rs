@@ -1,0 +1,111 @@
+//! Criterion benchmarks of rcs-runtime: Global Memory write+read against a
+//! plain copy, and executive overhead per controller per cycle.
+//!
+//! `cargo bench -p rcs-runtime --bench runtime -- --warm-up-time 1 --measurement-time 3`
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use rcs_runtime::{Controller, CycleContext, Executive, ExecutiveConfig, GlobalMemory};
+
+/// A buffer of `N` words; its contents only matter for their size.
+#[derive(Clone, Copy)]
+#[allow(dead_code)]
+struct Buf<const N: usize> {
+    words: [u64; N],
+}
+
+impl<const N: usize> Default for Buf<N> {
+    fn default() -> Self {
+        Self { words: [0; N] }
+    }
+}
+
+impl<const N: usize> Buf<N> {
+    fn new() -> Self {
+        Self { words: [7; N] }
+    }
+}
+
+fn gm_bench<const N: usize>(c: &mut Criterion) {
+    let bytes = N * 8;
+    let mut g = c.benchmark_group(format!("gm_{bytes}B"));
+    let gm = GlobalMemory::new();
+    gm.declare::<Buf<N>>("b").unwrap();
+    let mut w = gm.writer::<Buf<N>>("b").unwrap();
+    let r = gm.reader::<Buf<N>>("b").unwrap();
+    let v = Buf::<N>::new();
+    let mut cycle = 0u64;
+    g.bench_function("write+read", |b| {
+        b.iter(|| {
+            cycle += 1;
+            w.write(black_box(v), cycle);
+            black_box(r.read())
+        })
+    });
+    let mut slot = Buf::<N>::default();
+    g.bench_function("plain copy in+out", |b| {
+        b.iter(|| {
+            let dst = black_box(&mut slot);
+            *dst = black_box(v);
+            black_box(*black_box(&*dst))
+        })
+    });
+    g.finish();
+}
+
+struct Noop(&'static str, u64);
+impl Controller for Noop {
+    fn name(&self) -> &str {
+        self.0
+    }
+    fn cycle(&mut self, ctx: &CycleContext) {
+        self.1 = black_box(ctx.cycle);
+    }
+}
+
+const NAMES: [&str; 10] = ["C0", "C1", "C2", "C3", "C4", "C5", "C6", "C7", "C8", "C9"];
+
+fn exec_bench(c: &mut Criterion) {
+    let mut g = c.benchmark_group("executive_10_noop_controllers");
+    g.throughput(Throughput::Elements(NAMES.len() as u64));
+    for measure in [true, false] {
+        let cfg = ExecutiveConfig::new("bench", Duration::from_millis(1)).with_measure(measure);
+        let mut e = Executive::new(cfg).unwrap();
+        for n in NAMES {
+            e.add(Box::new(Noop(n, 0))).unwrap();
+        }
+        let label = if measure {
+            "cycle (timing on)"
+        } else {
+            "cycle (timing off)"
+        };
+        g.bench_function(label, |b| b.iter(|| e.step()));
+    }
+    // Baseline: the same ten dynamic calls without the executive.
+    let mut ctrls: Vec<Box<dyn Controller>> =
+        NAMES.iter().map(|n| Box::new(Noop(n, 0)) as _).collect();
+    let ctx = CycleContext {
+        cycle: 0,
+        now: std::time::Instant::now(),
+        period: Duration::from_millis(1),
+    };
+    g.bench_function("bare dyn calls", |b| {
+        b.iter(|| {
+            for c in ctrls.iter_mut() {
+                c.cycle(black_box(&ctx));
+            }
+        })
+    });
+    g.finish();
+}
+
+fn benches(c: &mut Criterion) {
+    gm_bench::<8>(c); // 64 bytes
+    gm_bench::<64>(c); // 512 bytes
+    exec_bench(c);
+}
+
+criterion_group!(group, benches);
+criterion_main!(group);

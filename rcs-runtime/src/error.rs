@@ -1,0 +1,32 @@
+//! Setup errors: everything that can go wrong while a system is wired
+//! together, before the first cycle. The cycle path itself has no errors to
+//! return (it reports through status buffers and counters instead).
+
+use thiserror::Error;
+
+/// An error while setting up Global Memory or an executive.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum SetupError {
+    /// A second writer handle was requested for a buffer (one writer only).
+    #[error("buffer `{0}` already has a writer (one writer, many readers)")]
+    WriterTaken(String),
+    /// A reader or writer names a buffer that was never declared.
+    #[error("unknown buffer `{0}`")]
+    UnknownBuffer(String),
+    /// A buffer is used with a type other than the one it was declared with.
+    #[error("buffer `{name}` holds `{declared}`, not `{requested}`")]
+    TypeMismatch {
+        /// The buffer's name.
+        name: String,
+        /// The type it was declared with.
+        declared: &'static str,
+        /// The type that was asked for.
+        requested: &'static str,
+    },
+    /// Two controllers of one executive share a name.
+    #[error("controller `{0}` is already scheduled on executive `{1}`")]
+    DuplicateController(String, String),
+    /// An executive period of zero.
+    #[error("executive `{0}` has a zero period")]
+    ZeroPeriod(String),
+}

@@ -1,0 +1,556 @@
+//! The executive: the seed's main program template (§5.4, Appendix B) for
+//! one CPU.
+//!
+//! An [`Executive`] owns a fixed list of [`Controller`]s and runs them in that
+//! order once per heartbeat. It keeps the cycle count, waits for absolute
+//! deadlines (sleep, then spin the last stretch), counts overruns, and keeps
+//! per-controller execution time statistics. Modes: run on the heartbeat
+//! ([`Executive::run`]), pause / single-step / go through an
+//! [`ExecutiveHandle`] from any thread, and run N cycles as fast as possible
+//! ([`Executive::run_cycles`]) for tests and simulation.
+//!
+//! Several executives, each on its own thread with its own period, can share
+//! one [`GlobalMemory`](crate::GlobalMemory); the handshake keeps them
+//! correct without synchronising their cycles (§5.5).
+//!
+//! Nothing here allocates or locks once the controllers are added, unless a
+//! trace sink is attached ([`Executive::set_trace`]).
+
+use std::io;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use crate::error::SetupError;
+use crate::plan::{Bookkeeping, SampleStats, Tick};
+use crate::trace::{TraceRecord, TraceSink};
+
+/// What the executive tells a controller about the cycle it runs in.
+#[derive(Debug, Clone, Copy)]
+pub struct CycleContext {
+    /// The executive's cycle count (0 on the first cycle). Stamp writes with it.
+    pub cycle: u64,
+    /// When this controller's turn began.
+    pub now: Instant,
+    /// The executive's period.
+    pub period: Duration,
+}
+
+impl CycleContext {
+    /// The cycle count and start instant as a [`Tick`] for [`Bookkeeping`].
+    #[inline]
+    pub fn tick(&self) -> Tick {
+        Tick {
+            cycle: self.cycle,
+            now: self.now,
+        }
+    }
+}
+
+/// A controller module (or simulator, or driver) that an executive runs once
+/// per cycle. A controller only talks to others through Global Memory.
+pub trait Controller: Send {
+    /// The controller's name, for statistics and traces.
+    fn name(&self) -> &str;
+
+    /// One read/compute/write cycle. Must not block.
+    fn cycle(&mut self, ctx: &CycleContext);
+
+    /// The controller's plan bookkeeping, if it has one: the executive reads
+    /// it for traces and per-verb statistics.
+    fn bookkeeping(&self) -> Option<&Bookkeeping> {
+        None
+    }
+}
+
+/// How the executive waits for the next deadline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Wait {
+    /// Sleep until the deadline (the OS decides how late it wakes up).
+    Sleep,
+    /// Sleep until `spin` before the deadline, then spin on the clock.
+    SleepSpin(Duration),
+    /// Spin on the clock the whole time (burns the core).
+    Spin,
+}
+
+impl Default for Wait {
+    fn default() -> Self {
+        Wait::SleepSpin(Duration::from_micros(200))
+    }
+}
+
+/// A periodic clock with absolute deadlines: deadline `k` is `start + k ×
+/// period`, so lateness does not accumulate. A deadline that is already a
+/// whole period past is skipped (counted by the caller as an overrun), and
+/// the schedule restarts from now.
+#[derive(Debug, Clone)]
+pub struct Heartbeat {
+    period: Duration,
+    wait: Wait,
+    next: Option<Instant>,
+}
+
+impl Heartbeat {
+    /// A heartbeat of `period`, waiting with `wait`.
+    pub fn new(period: Duration, wait: Wait) -> Self {
+        Self {
+            period,
+            wait,
+            next: None,
+        }
+    }
+
+    /// Start the schedule: the first deadline is one period after `now`.
+    pub fn start(&mut self, now: Instant) {
+        self.next = Some(now + self.period);
+    }
+
+    /// Wait for the next deadline and return how late it woke (zero or
+    /// more). Starts the schedule if [`start`](Self::start) was not called.
+    pub fn wait(&mut self) -> Duration {
+        let deadline = match self.next {
+            Some(d) => d,
+            None => {
+                let d = Instant::now() + self.period;
+                self.next = Some(d);
+                d
+            }
+        };
+        let spin = match self.wait {
+            Wait::Sleep => Duration::ZERO,
+            Wait::SleepSpin(s) => s,
+            Wait::Spin => self.period,
+        };
+        let now = Instant::now();
+        if let Some(left) = deadline.checked_duration_since(now) {
+            if left > spin {
+                std::thread::sleep(left - spin);
+            }
+        }
+        let mut woke = Instant::now();
+        while woke < deadline {
+            std::hint::spin_loop();
+            woke = Instant::now();
+        }
+        let mut next = deadline + self.period;
+        if next <= woke {
+            next = woke + self.period;
+        }
+        self.next = Some(next);
+        woke.saturating_duration_since(deadline)
+    }
+
+    /// The period.
+    pub fn period(&self) -> Duration {
+        self.period
+    }
+}
+
+/// Execution-time statistics of one controller (§5.3.3: last, min, max,
+/// mean), in nanoseconds, and how often it alone took longer than a period.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct ControllerStats {
+    /// Execution time per cycle, nanoseconds.
+    pub exec_ns: SampleStats,
+    /// Cycles in which this controller alone took longer than the period.
+    pub overruns: u64,
+}
+
+/// Statistics of an executive.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct ExecutiveStats {
+    /// Cycles run.
+    pub cycles: u64,
+    /// Cycles whose controllers together took longer than the period.
+    pub overruns: u64,
+    /// Duration of a whole cycle (all controllers), nanoseconds.
+    pub cycle_ns: SampleStats,
+    /// How late each heartbeat woke after its deadline, nanoseconds (only
+    /// in [`Executive::run`]).
+    pub lateness_ns: SampleStats,
+}
+
+/// Settings of an executive.
+#[derive(Debug, Clone)]
+pub struct ExecutiveConfig {
+    /// The name of this executive ("CPU").
+    pub name: String,
+    /// The heartbeat period.
+    pub period: Duration,
+    /// How to wait for deadlines (default: sleep, then spin the last 200 µs).
+    pub wait: Wait,
+    /// Measure per-controller execution time (default true). Turning it off
+    /// saves two clock reads per controller per cycle; overruns are then
+    /// judged on the whole cycle only.
+    pub measure: bool,
+}
+
+impl ExecutiveConfig {
+    /// An executive called `name` with heartbeat `period`, sleep+spin waits
+    /// and timing on.
+    pub fn new(name: impl Into<String>, period: Duration) -> Self {
+        Self {
+            name: name.into(),
+            period,
+            wait: Wait::default(),
+            measure: true,
+        }
+    }
+
+    /// The same with another wait strategy.
+    pub fn with_wait(mut self, wait: Wait) -> Self {
+        self.wait = wait;
+        self
+    }
+
+    /// The same with per-controller timing on or off.
+    pub fn with_measure(mut self, measure: bool) -> Self {
+        self.measure = measure;
+        self
+    }
+}
+
+#[derive(Debug, Default)]
+struct Shared {
+    paused: AtomicBool,
+    steps: AtomicU64,
+    stop: AtomicBool,
+    cycle: AtomicU64,
+    overruns: AtomicU64,
+}
+
+/// Remote control of an executive, usable from any thread (the operator's
+/// pause / step / go, Appendix B). Lock-free: the executive polls it with an
+/// atomic load between cycles.
+#[derive(Debug, Clone)]
+pub struct ExecutiveHandle {
+    shared: Arc<Shared>,
+}
+
+impl ExecutiveHandle {
+    /// Stop running controllers (the heartbeat keeps ticking).
+    pub fn pause(&self) {
+        self.shared.paused.store(true, Ordering::SeqCst);
+    }
+    /// Pause, and run exactly one more cycle on the next heartbeat.
+    pub fn step(&self) {
+        self.shared.paused.store(true, Ordering::SeqCst);
+        self.shared.steps.fetch_add(1, Ordering::SeqCst);
+    }
+    /// Run freely again.
+    pub fn go(&self) {
+        self.shared.steps.store(0, Ordering::SeqCst);
+        self.shared.paused.store(false, Ordering::SeqCst);
+    }
+    /// Make [`Executive::run`] return after the current cycle.
+    pub fn stop(&self) {
+        self.shared.stop.store(true, Ordering::SeqCst);
+    }
+    /// Whether the executive is paused.
+    pub fn is_paused(&self) -> bool {
+        self.shared.paused.load(Ordering::SeqCst)
+    }
+    /// Cycles run so far.
+    pub fn cycle(&self) -> u64 {
+        self.shared.cycle.load(Ordering::Acquire)
+    }
+    /// Overruns counted so far.
+    pub fn overruns(&self) -> u64 {
+        self.shared.overruns.load(Ordering::Acquire)
+    }
+    /// Single steps requested and not yet run.
+    pub fn pending_steps(&self) -> u64 {
+        self.shared.steps.load(Ordering::SeqCst)
+    }
+}
+
+struct Slot {
+    name: String,
+    ctrl: Box<dyn Controller>,
+    stats: ControllerStats,
+}
+
+/// The main program of one CPU. See the module docs.
+pub struct Executive {
+    name: String,
+    period: Duration,
+    period_ns: u64,
+    measure: bool,
+    heartbeat: Heartbeat,
+    slots: Vec<Slot>,
+    cycle: u64,
+    stats: ExecutiveStats,
+    shared: Arc<Shared>,
+    trace: Option<TraceSink>,
+}
+
+impl std::fmt::Debug for Executive {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Executive")
+            .field("name", &self.name)
+            .field("period", &self.period)
+            .field("controllers", &self.controller_names().collect::<Vec<_>>())
+            .field("cycle", &self.cycle)
+            .finish()
+    }
+}
+
+fn nanos(d: Duration) -> u64 {
+    u64::try_from(d.as_nanos()).unwrap_or(u64::MAX)
+}
+
+impl Executive {
+    /// A new executive with no controllers.
+    pub fn new(config: ExecutiveConfig) -> Result<Self, SetupError> {
+        if config.period.is_zero() {
+            return Err(SetupError::ZeroPeriod(config.name));
+        }
+        Ok(Self {
+            heartbeat: Heartbeat::new(config.period, config.wait),
+            period_ns: nanos(config.period),
+            period: config.period,
+            measure: config.measure,
+            name: config.name,
+            slots: Vec::new(),
+            cycle: 0,
+            stats: ExecutiveStats::default(),
+            shared: Arc::default(),
+            trace: None,
+        })
+    }
+
+    /// Append a controller to the fixed execution order.
+    pub fn add(&mut self, ctrl: Box<dyn Controller>) -> Result<(), SetupError> {
+        let name = ctrl.name().to_owned();
+        if self.slots.iter().any(|s| s.name == name) {
+            return Err(SetupError::DuplicateController(name, self.name.clone()));
+        }
+        self.slots.push(Slot {
+            name,
+            ctrl,
+            stats: ControllerStats::default(),
+        });
+        Ok(())
+    }
+
+    /// Attach a trace sink: from now on every controller's verb, state,
+    /// status, error and fired row is written as one JSON line per controller
+    /// per cycle. **This allocates and does I/O on the cycle path**; it is
+    /// for debugging and replay, not for production timing.
+    pub fn set_trace(&mut self, sink: TraceSink) {
+        self.trace = Some(sink);
+    }
+
+    /// Detach and return the trace sink.
+    pub fn take_trace(&mut self) -> Option<TraceSink> {
+        self.trace.take()
+    }
+
+    /// A handle to pause, step, resume and stop this executive from anywhere.
+    pub fn handle(&self) -> ExecutiveHandle {
+        ExecutiveHandle {
+            shared: Arc::clone(&self.shared),
+        }
+    }
+
+    /// Run exactly one cycle now, without waiting (single step for tests and
+    /// simulation; ignores pause).
+    pub fn step(&mut self) {
+        self.run_one();
+    }
+
+    /// Run `n` cycles back to back, as fast as possible (ignores pause).
+    pub fn run_cycles(&mut self, n: u64) {
+        for _ in 0..n {
+            self.run_one();
+        }
+    }
+
+    /// Run on the heartbeat until [`ExecutiveHandle::stop`] is called.
+    /// Honours pause / step / go. A stop requested before `run` makes it
+    /// return at once. Runs the first cycle immediately, then waits for each
+    /// deadline after the cycle (Appendix B's order).
+    pub fn run(&mut self) {
+        self.run_heartbeats(None);
+    }
+
+    /// Run on the heartbeat for `beats` heartbeats (or until stopped). A
+    /// paused heartbeat counts as a beat but runs no cycle.
+    pub fn run_for(&mut self, beats: u64) {
+        self.run_heartbeats(Some(beats));
+    }
+
+    fn run_heartbeats(&mut self, limit: Option<u64>) {
+        self.heartbeat.start(Instant::now());
+        let mut beats = 0u64;
+        loop {
+            if self.shared.stop.load(Ordering::Acquire) {
+                break;
+            }
+            if limit.is_some_and(|l| beats >= l) {
+                break;
+            }
+            beats += 1;
+            let paused = self.shared.paused.load(Ordering::Acquire);
+            let stepping = paused
+                && self
+                    .shared
+                    .steps
+                    .fetch_update(Ordering::AcqRel, Ordering::Acquire, |s| s.checked_sub(1))
+                    .is_ok();
+            if !paused || stepping {
+                self.run_one();
+            }
+            let late = self.heartbeat.wait();
+            self.stats.lateness_ns.record(nanos(late));
+        }
+    }
+
+    /// Spawn this executive on its own thread, running on the heartbeat
+    /// until stopped; the thread returns the executive (with its statistics).
+    pub fn spawn(mut self) -> io::Result<(ExecutiveHandle, JoinHandle<Executive>)> {
+        let handle = self.handle();
+        let join = std::thread::Builder::new()
+            .name(format!("rcs-exec-{}", self.name))
+            .spawn(move || {
+                self.run();
+                self
+            })?;
+        Ok((handle, join))
+    }
+
+    #[inline]
+    fn run_one(&mut self) {
+        let cycle = self.cycle;
+        let period = self.period;
+        let start = Instant::now();
+        let mut t0 = start;
+        for slot in &mut self.slots {
+            let ctx = CycleContext {
+                cycle,
+                now: t0,
+                period,
+            };
+            slot.ctrl.cycle(&ctx);
+            if self.measure {
+                let t1 = Instant::now();
+                let ns = nanos(t1.saturating_duration_since(t0));
+                slot.stats.exec_ns.record(ns);
+                if ns > self.period_ns {
+                    slot.stats.overruns = slot.stats.overruns.saturating_add(1);
+                }
+                t0 = t1;
+            }
+            if let Some(trace) = &mut self.trace {
+                let bk = slot.ctrl.bookkeeping();
+                trace.write(&TraceRecord {
+                    executive: &self.name,
+                    cycle,
+                    controller: &slot.name,
+                    verb: bk.map(|b| b.verb()),
+                    state: bk.map(|b| b.state()),
+                    status: bk.map(|b| b.status().0),
+                    error: bk.map(|b| b.error().0),
+                    fired: bk.and_then(|b| b.fired()),
+                    new_command: bk.is_some_and(|b| b.new_command()),
+                });
+            }
+        }
+        let end = if self.measure { t0 } else { Instant::now() };
+        let ns = nanos(end.saturating_duration_since(start));
+        self.stats.cycle_ns.record(ns);
+        if ns > self.period_ns {
+            self.stats.overruns = self.stats.overruns.saturating_add(1);
+            self.shared
+                .overruns
+                .store(self.stats.overruns, Ordering::Release);
+        }
+        self.cycle = cycle.wrapping_add(1);
+        self.stats.cycles = self.cycle;
+        self.shared.cycle.store(self.cycle, Ordering::Release);
+    }
+
+    /// This executive's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// The heartbeat period.
+    pub fn period(&self) -> Duration {
+        self.period
+    }
+    /// Cycles run so far.
+    pub fn cycle(&self) -> u64 {
+        self.cycle
+    }
+    /// Cycles that overran the period.
+    pub fn overruns(&self) -> u64 {
+        self.stats.overruns
+    }
+    /// Executive-wide statistics.
+    pub fn stats(&self) -> &ExecutiveStats {
+        &self.stats
+    }
+    /// Names of the controllers in execution order.
+    pub fn controller_names(&self) -> impl Iterator<Item = &str> {
+        self.slots.iter().map(|s| s.name.as_str())
+    }
+    /// Execution-time statistics of controller `name`.
+    pub fn controller_stats(&self, name: &str) -> Option<&ControllerStats> {
+        self.slots.iter().find(|s| s.name == name).map(|s| &s.stats)
+    }
+    /// Controller `name` itself (e.g. to inspect its bookkeeping).
+    pub fn controller(&self, name: &str) -> Option<&dyn Controller> {
+        self.slots
+            .iter()
+            .find(|s| s.name == name)
+            .map(|s| s.ctrl.as_ref())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn heartbeat_deadlines_are_absolute() {
+        for wait in [Wait::Sleep, Wait::default(), Wait::Spin] {
+            let period = Duration::from_millis(2);
+            let mut hb = Heartbeat::new(period, wait);
+            let start = Instant::now();
+            hb.start(start);
+            for _ in 0..10 {
+                let _late = hb.wait();
+            }
+            // Never early: the 10th deadline is 10 periods after the start.
+            assert!(start.elapsed() >= period * 10, "{wait:?}");
+            assert_eq!(hb.period(), period);
+        }
+    }
+
+    #[test]
+    fn heartbeat_skips_missed_deadlines() {
+        let period = Duration::from_millis(1);
+        let mut hb = Heartbeat::new(period, Wait::Sleep);
+        hb.start(Instant::now());
+        std::thread::sleep(Duration::from_millis(5));
+        let late = hb.wait();
+        assert!(late >= Duration::from_millis(3));
+        // The schedule restarted from now: the next wait is about a period.
+        let t = Instant::now();
+        let _ = hb.wait();
+        assert!(t.elapsed() < Duration::from_millis(50));
+    }
+
+    #[test]
+    fn cycle_context_tick() {
+        let now = Instant::now();
+        let ctx = CycleContext {
+            cycle: 4,
+            now,
+            period: Duration::from_millis(1),
+        };
+        assert_eq!(ctx.tick(), Tick { cycle: 4, now });
+    }
+}

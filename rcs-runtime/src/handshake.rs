@@ -1,0 +1,483 @@
+//! Command and status buffers and the supervisor/subordinate handshake
+//! (§5.5 of the methodology; SEMANTICS.md "Buffers" and step 2).
+//!
+//! A supervisor commands a subordinate by writing its command buffer with a
+//! fresh serial number; the subordinate echoes the serial of the command it
+//! works on in its status buffer. The supervisor trusts a status only when
+//! the echo matches the serial it last sent: otherwise the subordinate has not
+//! picked the command up yet, and the supervisor sees EXECUTING. The
+//! generation stamps of Global Memory give the watchdog count
+//! `stale_cycles`.
+//!
+//! The ids here are small plain integers so that both generated code (typed
+//! enums converted to ids) and an interpreter (ids known at run time) use the
+//! same types.
+
+use serde::{Deserialize, Serialize};
+
+use crate::gm::{GlobalMemory, Reader, Stamped, Writer};
+use crate::SetupError;
+
+/// A command verb of one controller, by its position in the declaration.
+pub type VerbId = u16;
+/// A state of one plan; `S0` is 0.
+pub type StateId = u16;
+/// A row of one plan, by its 0-based position (precedence order).
+pub type RowId = u16;
+
+/// The state every plan starts in after a new command.
+pub const S0: StateId = 0;
+
+/// A status code: 0..=3 are the built-in statuses, custom statuses (declared
+/// with `status NAME` in a controller) follow from 4.
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
+#[serde(transparent)]
+pub struct Status(pub u16);
+
+impl Status {
+    /// No command has been received yet.
+    pub const NOT_READY: Status = Status(0);
+    /// Working on the command whose serial is echoed.
+    pub const EXECUTING: Status = Status(1);
+    /// The command's plan ended with `Done`.
+    pub const DONE: Status = Status(2);
+    /// The command's plan ended with `Error(CODE)`, or the verb had no plan.
+    pub const ERROR: Status = Status(3);
+    /// The code of the first custom status.
+    pub const FIRST_CUSTOM: u16 = 4;
+
+    /// The `index`-th custom status of a controller (0-based).
+    pub const fn custom(index: u16) -> Status {
+        Status(Self::FIRST_CUSTOM.saturating_add(index))
+    }
+
+    /// The built-in name, or `None` for a custom status.
+    pub const fn builtin_name(self) -> Option<&'static str> {
+        match self.0 {
+            0 => Some("NOT_READY"),
+            1 => Some("EXECUTING"),
+            2 => Some("DONE"),
+            3 => Some("ERROR"),
+            _ => None,
+        }
+    }
+}
+
+/// An error code: 0 is "no error", 1 is the runtime's `UNKNOWN_COMMAND`,
+/// error codes declared by a controller follow from 2.
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
+#[serde(transparent)]
+pub struct ErrorCode(pub u16);
+
+impl ErrorCode {
+    /// No error.
+    pub const NONE: ErrorCode = ErrorCode(0);
+    /// A command verb for which the controller has no plan.
+    pub const UNKNOWN_COMMAND: ErrorCode = ErrorCode(1);
+    /// The code of the first declared error.
+    pub const FIRST_CUSTOM: u16 = 2;
+
+    /// The `index`-th declared error code of a controller (0-based).
+    pub const fn custom(index: u16) -> ErrorCode {
+        ErrorCode(Self::FIRST_CUSTOM.saturating_add(index))
+    }
+
+    /// Whether this is [`ErrorCode::NONE`].
+    pub const fn is_none(self) -> bool {
+        self.0 == 0
+    }
+}
+
+/// The payload of a command buffer: a generated command enum (verb and
+/// parameters) or anything else that knows its verb id. Its `Default` is the
+/// value of a never-written buffer.
+pub trait Command: Copy + Default + Send + 'static {
+    /// The verb of this command.
+    fn verb(&self) -> VerbId;
+}
+
+/// A bare verb id is a command without parameters (handy for tests and for
+/// an interpreter that keeps parameters elsewhere).
+impl Command for VerbId {
+    fn verb(&self) -> VerbId {
+        *self
+    }
+}
+
+/// A controller's command buffer: `{serial, verb, params}`, with verb and
+/// parameters in `command`. Serial 0 means "no command yet".
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct CommandBuffer<C> {
+    /// Serial number of this command; a new serial is a new command.
+    pub serial: u32,
+    /// The verb and its parameters.
+    pub command: C,
+}
+
+impl<C: Command> CommandBuffer<C> {
+    /// The verb of the command.
+    pub fn verb(&self) -> VerbId {
+        self.command.verb()
+    }
+}
+
+/// A controller's status buffer, plain data. All zeros before the first
+/// write: `{echo_serial: 0, NOT_READY, no error}`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct StatusBuffer {
+    /// Serial of the command this status is about.
+    pub echo_serial: u32,
+    /// The status.
+    pub status: Status,
+    /// The error code when `status` is ERROR, else NONE.
+    pub error: ErrorCode,
+    /// The verb of the echoed command.
+    pub verb: VerbId,
+    /// The current state of its plan.
+    pub state: StateId,
+}
+
+/// The serial after `serial`: one more, wrapping from `u32::MAX` to 1, never 0.
+#[inline]
+pub const fn next_serial(serial: u32) -> u32 {
+    match serial.wrapping_add(1) {
+        0 => 1,
+        n => n,
+    }
+}
+
+/// What a supervisor sees of one subordinate in one cycle (step 2).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SubordinateView {
+    /// The status through the handshake: EXECUTING while the echo differs
+    /// from the serial last sent.
+    pub status: Status,
+    /// The error code, only when `status` is ERROR through the handshake.
+    pub error: ErrorCode,
+    /// Cycles of the supervisor since the subordinate last wrote its status.
+    pub stale_cycles: u32,
+    /// The buffer exactly as read.
+    pub raw: StatusBuffer,
+}
+
+impl SubordinateView {
+    /// `X.done`.
+    pub fn done(&self) -> bool {
+        self.status == Status::DONE
+    }
+    /// `X.executing`.
+    pub fn executing(&self) -> bool {
+        self.status == Status::EXECUTING
+    }
+    /// `X.error`.
+    pub fn error(&self) -> bool {
+        self.status == Status::ERROR
+    }
+}
+
+/// A supervisor's bookkeeping for one subordinate: the serial it last sent,
+/// the last status generation it saw and the resulting view. Works on plain
+/// values, so it serves generated code and interpreters alike.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SubordinateLink {
+    last_sent: u32,
+    seen_generation: u64,
+    view: SubordinateView,
+}
+
+impl SubordinateLink {
+    /// A link that has sent nothing yet.
+    pub const fn new() -> Self {
+        Self {
+            last_sent: 0,
+            seen_generation: 0,
+            view: SubordinateView {
+                status: Status::NOT_READY,
+                error: ErrorCode::NONE,
+                stale_cycles: 0,
+                raw: StatusBuffer {
+                    echo_serial: 0,
+                    status: Status::NOT_READY,
+                    error: ErrorCode::NONE,
+                    verb: 0,
+                    state: 0,
+                },
+            },
+        }
+    }
+
+    /// Step 2 for this subordinate: take this cycle's read of its status
+    /// buffer (call once per cycle of the supervisor) and compute the view.
+    ///
+    /// `stale_cycles` is 0 when the read shows a generation not seen before
+    /// and one more than last cycle otherwise. A buffer that was never written
+    /// (generation 0) counts as not new, so a subordinate that never spoke
+    /// is stale from the first cycle.
+    #[inline]
+    pub fn observe(&mut self, read: &Stamped<StatusBuffer>) -> SubordinateView {
+        let stale = if read.generation != self.seen_generation {
+            self.seen_generation = read.generation;
+            0
+        } else {
+            self.view.stale_cycles.saturating_add(1)
+        };
+        let raw = read.value;
+        let (status, error) = if raw.echo_serial == self.last_sent {
+            (raw.status, raw.error)
+        } else {
+            // A status for an older command never counts for the newer one.
+            (Status::EXECUTING, ErrorCode::NONE)
+        };
+        self.view = SubordinateView {
+            status,
+            error,
+            stale_cycles: stale,
+            raw,
+        };
+        self.view
+    }
+
+    /// The view computed by the last [`observe`](Self::observe).
+    #[inline]
+    pub fn view(&self) -> SubordinateView {
+        self.view
+    }
+
+    /// Allocate the serial of a new command to this subordinate and remember
+    /// it as the last one sent. The view of this cycle is not changed (the
+    /// conditions of a cycle are evaluated before its jobs run).
+    #[inline]
+    pub fn next_command(&mut self) -> u32 {
+        self.last_sent = next_serial(self.last_sent);
+        self.last_sent
+    }
+
+    /// The serial of the last command sent (0: none).
+    #[inline]
+    pub fn last_sent(&self) -> u32 {
+        self.last_sent
+    }
+
+    /// Start the serials after `serial` (e.g. to resume after a restart, or
+    /// to test wrap-around).
+    pub fn set_last_sent(&mut self, serial: u32) {
+        self.last_sent = serial;
+    }
+}
+
+/// Everything a supervisor needs for one subordinate: the link, a reader of
+/// its status buffer and the writer of its command buffer.
+///
+/// Per cycle: [`read`](Self::read) in pre-processing, [`view`](Self::view) in
+/// the decision, [`send`](Self::send) in a job, [`flush`](Self::flush) in
+/// post-processing.
+#[derive(Debug)]
+pub struct Subordinate<C: Command> {
+    link: SubordinateLink,
+    status: Reader<StatusBuffer>,
+    command: Writer<CommandBuffer<C>>,
+    out: CommandBuffer<C>,
+    dirty: bool,
+}
+
+impl<C: Command> Subordinate<C> {
+    /// Connect to subordinate `ctrl` in `gm` (its buffers are declared if
+    /// needed; taking its command writer makes this the only supervisor).
+    pub fn connect(gm: &GlobalMemory, ctrl: &str) -> Result<Self, SetupError> {
+        gm.declare_controller::<C>(ctrl)?;
+        Ok(Self {
+            link: SubordinateLink::new(),
+            status: gm.status_reader(ctrl)?,
+            command: gm.command_writer::<C>(ctrl)?,
+            out: CommandBuffer::default(),
+            dirty: false,
+        })
+    }
+
+    /// Step 1 and 2: read the status buffer once and compute the view.
+    #[inline]
+    pub fn read(&mut self) -> SubordinateView {
+        let s = self.status.read();
+        self.link.observe(&s)
+    }
+
+    /// This cycle's view (from the last [`read`](Self::read)).
+    #[inline]
+    pub fn view(&self) -> SubordinateView {
+        self.link.view()
+    }
+
+    /// `X <- VERB(...)`: a new command with the next serial, written to
+    /// Global Memory at the next [`flush`](Self::flush). Returns the serial.
+    #[inline]
+    pub fn send(&mut self, command: C) -> u32 {
+        let serial = self.link.next_command();
+        self.out = CommandBuffer { serial, command };
+        self.dirty = true;
+        serial
+    }
+
+    /// Step 5: write the command buffer if a command was sent since the last
+    /// flush. Returns whether it wrote.
+    #[inline]
+    pub fn flush(&mut self, cycle: u64) -> bool {
+        if self.dirty {
+            self.command.write(self.out, cycle);
+            self.dirty = false;
+            true
+        } else {
+            false
+        }
+    }
+
+    /// The command most recently sent (serial 0: none).
+    pub fn last_command(&self) -> CommandBuffer<C> {
+        self.out
+    }
+
+    /// The underlying link.
+    pub fn link(&self) -> &SubordinateLink {
+        &self.link
+    }
+
+    /// The underlying link, mutably.
+    pub fn link_mut(&mut self) -> &mut SubordinateLink {
+        &mut self.link
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn stamped(echo: u32, status: Status, generation: u64) -> Stamped<StatusBuffer> {
+        Stamped {
+            value: StatusBuffer {
+                echo_serial: echo,
+                status,
+                error: if status == Status::ERROR {
+                    ErrorCode::custom(0)
+                } else {
+                    ErrorCode::NONE
+                },
+                verb: 0,
+                state: 0,
+            },
+            generation,
+            writer_cycle: generation,
+        }
+    }
+
+    #[test]
+    fn serials_wrap_to_one_never_zero() {
+        assert_eq!(next_serial(0), 1);
+        assert_eq!(next_serial(41), 42);
+        assert_eq!(next_serial(u32::MAX - 1), u32::MAX);
+        assert_eq!(next_serial(u32::MAX), 1);
+        let mut l = SubordinateLink::new();
+        l.set_last_sent(u32::MAX);
+        assert_eq!(l.next_command(), 1);
+        assert_eq!(l.last_sent(), 1);
+    }
+
+    #[test]
+    fn zeroed_buffers_read_not_ready() {
+        let s = StatusBuffer::default();
+        assert_eq!(s.echo_serial, 0);
+        assert_eq!(s.status, Status::NOT_READY);
+        assert!(s.error.is_none());
+        let c = CommandBuffer::<VerbId>::default();
+        assert_eq!((c.serial, c.verb()), (0, 0));
+        // Nothing sent, nothing written: the real NOT_READY shows through.
+        let mut l = SubordinateLink::new();
+        assert_eq!(l.observe(&Stamped::default()).status, Status::NOT_READY);
+    }
+
+    #[test]
+    fn status_echoing_older_serial_reads_executing() {
+        let mut l = SubordinateLink::new();
+        let s1 = l.next_command();
+        assert_eq!(
+            l.observe(&stamped(s1, Status::DONE, 1)).status,
+            Status::DONE
+        );
+        let s2 = l.next_command();
+        assert_eq!(s2, s1 + 1);
+        // The subordinate still shows DONE for s1: a stale DONE.
+        let v = l.observe(&stamped(s1, Status::DONE, 2));
+        assert_eq!(v.status, Status::EXECUTING);
+        assert!(!v.done());
+        assert_eq!(v.raw.status, Status::DONE);
+        // An ERROR for the older command is masked too.
+        let v = l.observe(&stamped(s1, Status::ERROR, 3));
+        assert_eq!((v.status, v.error), (Status::EXECUTING, ErrorCode::NONE));
+        // The echo arrives.
+        let v = l.observe(&stamped(s2, Status::ERROR, 4));
+        assert!(v.error());
+        assert_eq!(v.error, ErrorCode::custom(0));
+    }
+
+    #[test]
+    fn stale_cycles_grow_for_silent_and_reset_for_live() {
+        let mut silent = SubordinateLink::new();
+        let mut live = SubordinateLink::new();
+        let frozen = stamped(0, Status::NOT_READY, 5);
+        for cycle in 0..10u64 {
+            let vs = silent.observe(&frozen);
+            let vl = live.observe(&stamped(0, Status::NOT_READY, 6 + cycle));
+            assert_eq!(vs.stale_cycles as u64, cycle);
+            assert_eq!(vl.stale_cycles, 0);
+        }
+        // Never written: stale from the first cycle.
+        let mut mute = SubordinateLink::new();
+        assert_eq!(mute.observe(&Stamped::default()).stale_cycles, 1);
+        assert_eq!(mute.observe(&Stamped::default()).stale_cycles, 2);
+    }
+
+    #[test]
+    fn status_codes() {
+        assert_eq!(Status::custom(0), Status(4));
+        assert_eq!(Status::DONE.builtin_name(), Some("DONE"));
+        assert_eq!(Status::custom(1).builtin_name(), None);
+        assert_eq!(ErrorCode::custom(0), ErrorCode(2));
+        assert!(!ErrorCode::UNKNOWN_COMMAND.is_none());
+    }
+
+    #[test]
+    fn subordinate_port_round_trip() {
+        let gm = GlobalMemory::new();
+        let mut sub = Subordinate::<VerbId>::connect(&gm, "TB").unwrap();
+        // Only one supervisor: the command writer is taken.
+        assert!(matches!(
+            Subordinate::<VerbId>::connect(&gm, "TB"),
+            Err(SetupError::WriterTaken(_))
+        ));
+        let cmd = gm.command_reader::<VerbId>("TB").unwrap();
+        let mut st = gm.status_writer("TB").unwrap();
+        assert!(!sub.flush(1));
+        assert_eq!(cmd.read().generation, 0);
+        let serial = sub.send(3);
+        assert!(sub.flush(1));
+        let c = cmd.read();
+        assert_eq!(
+            (c.value.serial, c.value.verb(), c.writer_cycle),
+            (serial, 3, 1)
+        );
+        assert!(sub.read().executing());
+        st.write(
+            StatusBuffer {
+                echo_serial: serial,
+                status: Status::DONE,
+                ..Default::default()
+            },
+            7,
+        );
+        assert!(sub.read().done());
+        assert!(sub.view().done());
+        assert_eq!(sub.last_command().serial, serial);
+    }
+}

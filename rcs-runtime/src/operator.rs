@@ -1,0 +1,82 @@
+//! The operator interface (§3.7, Appendix B): command a root controller and
+//! read any status buffer. Pause, single-step and go are on
+//! [`ExecutiveHandle`](crate::ExecutiveHandle).
+//!
+//! The operator is the supervisor of a root controller: it holds the single
+//! writer of the root's command buffer and follows the same handshake as a
+//! controller, so the human never bypasses the chain of command. An
+//! [`Operator`] is `Send` and works from any thread.
+
+use crate::gm::{GlobalMemory, Reader, Stamped};
+use crate::handshake::{
+    Command, CommandBuffer, ErrorCode, Status, StatusBuffer, SubordinateLink, SubordinateView,
+};
+use crate::SetupError;
+
+/// The operator's connection to one root controller.
+#[derive(Debug)]
+pub struct Operator<C: Command> {
+    link: SubordinateLink,
+    command: crate::gm::Writer<CommandBuffer<C>>,
+    status: Reader<StatusBuffer>,
+    sent: u64,
+}
+
+impl<C: Command> Operator<C> {
+    /// Connect to root controller `root` (declares its buffers if needed and
+    /// takes the writer of its command buffer).
+    pub fn connect(gm: &GlobalMemory, root: &str) -> Result<Self, SetupError> {
+        gm.declare_controller::<C>(root)?;
+        Ok(Self {
+            link: SubordinateLink::new(),
+            command: gm.command_writer(root)?,
+            status: gm.status_reader(root)?,
+            sent: 0,
+        })
+    }
+
+    /// Send a new command (next serial) at once. Returns its serial. The
+    /// write is stamped with the number of commands the operator has sent.
+    pub fn command(&mut self, command: C) -> u32 {
+        let serial = self.link.next_command();
+        self.sent = self.sent.wrapping_add(1);
+        self.command
+            .write(CommandBuffer { serial, command }, self.sent);
+        serial
+    }
+
+    /// The root's status buffer as it is.
+    pub fn status(&self) -> Stamped<StatusBuffer> {
+        self.status.read()
+    }
+
+    /// The root's status through the handshake: EXECUTING until the root
+    /// echoes the serial of the last command sent.
+    pub fn view(&mut self) -> SubordinateView {
+        let s = self.status.read();
+        self.link.observe(&s)
+    }
+
+    /// `Some((status, error))` once the root finished the last command with
+    /// DONE or ERROR; `None` while it runs (or has not picked it up).
+    pub fn outcome(&mut self) -> Option<(Status, ErrorCode)> {
+        let v = self.view();
+        (v.done() || v.error()).then_some((v.status, v.error))
+    }
+
+    /// Serial of the last command sent (0: none).
+    pub fn last_serial(&self) -> u32 {
+        self.link.last_sent()
+    }
+
+    /// Start serials after `serial` (e.g. to test wrap-around).
+    pub fn set_last_serial(&mut self, serial: u32) {
+        self.link.set_last_sent(serial);
+    }
+}
+
+/// Read controller `ctrl`'s status buffer once (setup-time lookup; keep a
+/// [`Reader`] from [`GlobalMemory::status_reader`] to poll repeatedly).
+pub fn read_status(gm: &GlobalMemory, ctrl: &str) -> Result<Stamped<StatusBuffer>, SetupError> {
+    Ok(gm.status_reader(ctrl)?.read())
+}

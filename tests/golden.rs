@@ -1,0 +1,197 @@
+//! Data-driven golden tests of the front end, over `tests/data/`:
+//!
+//! - `ok/NNNN_name.rcs` (or a folder with `rcs.yaml`): must check with no
+//!   diagnostic at all and yield an IR.
+//! - `err/NNNN_name.rcs` (or a folder): the first line of the (first) `.rcs`
+//!   file says which codes it must produce, `// expect: code, code`; the set
+//!   of codes produced must be exactly that. The full human and JSON
+//!   renderings are kept as insta snapshots in `err/snapshots/`.
+//!
+//! One walker serves every case; add a case by adding a file. The catalogue
+//! coverage test fails until every diagnostic code has at least two cases.
+
+use rcs_dsl::lint::Lint;
+use rcs_dsl::render::{self, Format};
+use rcs_dsl::{Code, Options};
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+fn cases(kind: &str) -> Vec<PathBuf> {
+    let dir = Path::new("tests/data").join(kind);
+    let mut out: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("readable entry").path())
+        .filter(|p| {
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            name.as_bytes()[0].is_ascii_digit()
+                && (p.is_dir() || p.extension().is_some_and(|e| e == "rcs"))
+        })
+        .collect();
+    out.sort();
+    assert!(!out.is_empty(), "no cases under {}", dir.display());
+    out
+}
+
+fn first_rcs(case: &Path) -> PathBuf {
+    if case.is_file() {
+        return case.to_path_buf();
+    }
+    let mut files: Vec<PathBuf> = Vec::new();
+    let mut stack = vec![case.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|e| e == "rcs") {
+                files.push(p);
+            }
+        }
+    }
+    files.sort();
+    files
+        .into_iter()
+        .next()
+        .unwrap_or_else(|| panic!("{}: no .rcs file", case.display()))
+}
+
+/// The codes a case declares on its first line: `// expect: a, b`.
+fn expected_codes(case: &Path) -> BTreeSet<String> {
+    let file = first_rcs(case);
+    let text = std::fs::read_to_string(&file).unwrap();
+    let first = text
+        .trim_start_matches('\u{feff}')
+        .lines()
+        .next()
+        .unwrap_or("");
+    let list = first.strip_prefix("// expect:").unwrap_or_else(|| {
+        panic!(
+            "{}: first line must be `// expect: CODE, …`",
+            file.display()
+        )
+    });
+    list.split(',')
+        .map(|s| s.trim().to_string())
+        .filter(|s| !s.is_empty())
+        .collect()
+}
+
+fn case_name(case: &Path) -> String {
+    case.file_stem().unwrap().to_string_lossy().into_owned()
+}
+
+/// Check one case; returns the plan set and its result.
+fn run(case: &Path) -> (rcs_dsl::PlanSet, rcs_dsl::Checked) {
+    let mut sets = rcs_dsl::load_paths(&[case.to_path_buf()])
+        .unwrap_or_else(|e| panic!("{}: {e}", case.display()));
+    assert_eq!(sets.len(), 1);
+    let set = sets.remove(0);
+    let checked = rcs_dsl::check(&set, &Options::default());
+    (set, checked)
+}
+
+/// Every label of every diagnostic lies inside its file, on char boundaries.
+fn assert_spans_inside(case: &Path, set: &rcs_dsl::PlanSet, checked: &rcs_dsl::Checked) {
+    for d in &checked.diagnostics {
+        for l in &d.labels {
+            let text = &set.sources.get(l.span.file).text;
+            assert!(
+                l.span.start <= l.span.end
+                    && (l.span.end as usize) <= text.len()
+                    && text.is_char_boundary(l.span.start as usize)
+                    && text.is_char_boundary(l.span.end as usize),
+                "{}: label {:?} outside its file",
+                case.display(),
+                l
+            );
+        }
+    }
+}
+
+#[test]
+fn ok_cases_check_clean() {
+    for case in cases("ok") {
+        let (set, checked) = run(&case);
+        let rendered: String = checked
+            .diagnostics
+            .iter()
+            .map(|d| render::render(d, &set.sources, Format::Short))
+            .collect();
+        assert!(
+            checked.diagnostics.is_empty(),
+            "{}:\n{rendered}",
+            case.display()
+        );
+        assert!(checked.ir.is_some(), "{}: no IR", case.display());
+    }
+}
+
+#[test]
+fn err_cases_match_expectations_and_snapshots() {
+    let mut problems = Vec::new();
+    for case in cases("err") {
+        let (set, checked) = run(&case);
+        assert_spans_inside(&case, &set, &checked);
+        let got: BTreeSet<String> = checked
+            .diagnostics
+            .iter()
+            .map(|d| d.code.name().to_string())
+            .collect();
+        let want = expected_codes(&case);
+        if got != want {
+            let shown: String = checked
+                .diagnostics
+                .iter()
+                .map(|d| render::render(d, &set.sources, Format::Short))
+                .collect();
+            problems.push(format!(
+                "{}: expected {want:?}, got {got:?}\n{shown}",
+                case.display()
+            ));
+            continue;
+        }
+        let mut out = String::new();
+        for d in &checked.diagnostics {
+            out.push_str(&render::render(
+                d,
+                &set.sources,
+                Format::Human { color: false },
+            ));
+        }
+        out.push_str("---- json\n");
+        for d in &checked.diagnostics {
+            out.push_str(&render::render(d, &set.sources, Format::Json));
+        }
+        insta::with_settings!({
+            snapshot_path => "data/err/snapshots",
+            prepend_module_to_snapshot => false,
+            omit_expression => true,
+            description => case.display().to_string(),
+        }, {
+            insta::assert_snapshot!(case_name(&case), out);
+        });
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// The catalogue is covered: every code has at least two failing cases.
+#[test]
+fn every_code_has_two_err_cases() {
+    let mut count: BTreeMap<String, usize> = BTreeMap::new();
+    for case in cases("err") {
+        for code in expected_codes(&case) {
+            *count.entry(code).or_default() += 1;
+        }
+    }
+    let all = Code::ERRORS.into_iter().chain(Lint::ALL.map(Code::Lint));
+    let thin: Vec<String> = all
+        .map(|c| c.name())
+        .filter(|n| count.get(*n).copied().unwrap_or(0) < 2)
+        .map(|n| format!("{n} ({})", count.get(n).copied().unwrap_or(0)))
+        .collect();
+    assert!(
+        thin.is_empty(),
+        "codes with fewer than two err cases: {}",
+        thin.join(", ")
+    );
+}

@@ -248,6 +248,9 @@ pub struct Controller {
     pub subordinate_spans: Vec<Span>,
     /// The span of each `subordinates` list as written.
     pub subordinates_lists: Vec<Span>,
+    /// Where each `reads`/`writes` buffer is declared (its name), for diagnostics.
+    #[serde(skip)]
+    pub buffer_spans: Vec<(BufferId, Span)>,
 }
 
 #[derive(Clone, Debug, Serialize)]

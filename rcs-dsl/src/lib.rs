@@ -11,6 +11,10 @@
 //! The IR is returned only when no error was found; it is the input of the
 //! code generator, the graph writer and the interpreter.
 
+// pest is used without its `std` feature (see the workspace Cargo.toml); its
+// derive then names `alloc` from the crate root.
+extern crate alloc;
+
 pub mod ast;
 mod checks;
 pub mod diagnostic;
@@ -66,12 +70,15 @@ pub fn check(set: &PlanSet, options: &Options) -> Checked {
         diags.push(d.clone());
     }
     let start = diags.len();
-    let mut files = Vec::with_capacity(set.rcs_files.len());
-    for &id in &set.rcs_files {
-        if unreadable.contains(&id) {
-            continue;
-        }
-        match parser::parse_file(id, &set.sources.get(id).text) {
+    let todo: Vec<source::FileId> = set
+        .rcs_files
+        .iter()
+        .copied()
+        .filter(|id| !unreadable.contains(id))
+        .collect();
+    let mut files = Vec::with_capacity(todo.len());
+    for result in parse_all(set, &todo) {
+        match result {
             Ok(f) => files.push(f),
             Err(ds) => ds.into_iter().for_each(|d| diags.push(d)),
         }
@@ -98,6 +105,33 @@ pub fn check(set: &PlanSet, options: &Options) -> Checked {
     checks::run(&ir, &levels, &set.sources, &mut diags);
     let ir = (!diags.has_errors()).then_some(ir);
     finish(ir, diags)
+}
+
+type Parsed = Result<ast::File, Vec<Diagnostic>>;
+
+/// Parse files, on as many threads as the machine has (files are
+/// independent), returning results in the order of `ids`.
+fn parse_all(set: &PlanSet, ids: &[source::FileId]) -> Vec<Parsed> {
+    let parse = |id: &source::FileId| parser::parse_file(*id, &set.sources.get(*id).text);
+    let bytes: usize = ids.iter().map(|id| set.sources.get(*id).text.len()).sum();
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(ids.len());
+    // Below ~256 KiB a thread costs more than it saves.
+    if threads < 2 || bytes < 256 * 1024 {
+        return ids.iter().map(parse).collect();
+    }
+    let chunk = ids.len().div_ceil(threads);
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = ids
+            .chunks(chunk)
+            .map(|part| scope.spawn(move || part.iter().map(parse).collect::<Vec<_>>()))
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    })
 }
 
 fn finish(ir: Option<ir::Ir>, diags: Diagnostics) -> Checked {

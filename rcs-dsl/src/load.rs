@@ -104,7 +104,8 @@ impl PlanSet {
                         format!(
                             "`{display}` is not valid UTF-8 (first bad byte at offset {offset})"
                         ),
-                        Span::new(id, offset, offset + 1),
+                        // The lossy text holds U+FFFD where the bad byte was.
+                        Span::new(id, offset, offset + '\u{FFFD}'.len_utf8()),
                         "invalid UTF-8 here",
                     )
                     .with_help("save the file as UTF-8"),

@@ -71,7 +71,9 @@ pub fn parse_file(file: FileId, text: &str) -> Result<File, Vec<Diagnostic>> {
 }
 
 /// Reject bracket nesting deeper than [`MAX_NESTING`] before pest sees the
-/// text, skipping comments and strings the way the grammar does.
+/// text, skipping comments and strings the way the grammar does. An
+/// unterminated block comment or string is reported here too, in plain
+/// words, where pest could only point at an unexpected `/` or `"`.
 fn check_nesting(file: FileId, text: &str) -> Result<(), Vec<Diagnostic>> {
     let bytes = text.as_bytes();
     let mut depth = 0usize;
@@ -84,19 +86,40 @@ fn check_nesting(file: FileId, text: &str) -> Result<(), Vec<Diagnostic>> {
                 }
             }
             b'/' if bytes.get(i + 1) == Some(&b'*') => {
+                let start = i;
                 i += 2;
                 while i < bytes.len() && !(bytes[i] == b'*' && bytes.get(i + 1) == Some(&b'/')) {
                     i += 1;
                 }
+                if i >= bytes.len() {
+                    // pest would only say that `/` is unexpected here.
+                    return Err(vec![Diagnostic::error(
+                        Code::Syntax,
+                        "unterminated block comment",
+                        Span::new(file, start, start + 2),
+                        "this comment is never closed",
+                    )
+                    .with_help("close it with `*/`; block comments do not nest")]);
+                }
                 i += 1;
             }
             b'"' => {
+                let start = i;
                 i += 1;
                 while i < bytes.len() && bytes[i] != b'"' && bytes[i] != b'\n' {
                     if bytes[i] == b'\\' {
                         i += 1;
                     }
                     i += 1;
+                }
+                if i >= bytes.len() || bytes[i] != b'"' {
+                    return Err(vec![Diagnostic::error(
+                        Code::Syntax,
+                        "unterminated string",
+                        Span::new(file, start, start + 1),
+                        "this string has no closing `\"` on its line",
+                    )
+                    .with_help("close the title with `\"`; strings cannot span lines")]);
                 }
             }
             b'(' | b'[' | b'{' => {
@@ -122,7 +145,7 @@ fn check_nesting(file: FileId, text: &str) -> Result<(), Vec<Diagnostic>> {
 /// Turn a pest failure into one diagnostic: where, what was expected, what was found.
 fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>) -> Diagnostic {
     use pest::error::{ErrorVariant, InputLocation};
-    let pos = match e.location {
+    let mut pos = match e.location {
         InputLocation::Pos(p) => p,
         InputLocation::Span((s, _)) => s,
     };
@@ -151,16 +174,47 @@ fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>) -> Diagno
         }
     }
     if let Some(attempts) = e.parse_attempts() {
-        for t in attempts.expected_tokens() {
-            // The token type is not exported; its Display is the literal text.
-            if let Some(w) = token_words(&t.to_string()) {
-                add(w);
+        // The token type is not exported; its Display is the literal text.
+        let tokens: Vec<String> = attempts
+            .expected_tokens()
+            .iter()
+            .filter_map(|t| token_words(&t.to_string()))
+            .collect();
+        if attempts.max_position > pos && !tokens.is_empty() {
+            // Punctuation was tried further on (`Error(CODE` missing its `)`):
+            // that is where the text went wrong, and the rules that failed
+            // earlier only describe what an optional part could have been.
+            // Point just after the last token, not at the next line.
+            let before = &text[..attempts.max_position.min(text.len())];
+            pos = pos.max(before.trim_end().len());
+            expected.clear();
+        }
+        for w in tokens {
+            if !expected.contains(&w) {
+                expected.push(w);
             }
         }
     }
     // `(` and `[` can start an expression; saying both is noise.
     if expected.iter().any(|w| w == "an expression") {
         expected.retain(|w| w != "`(`" && w != "`[`");
+    }
+    // `#` starts an attribute, which is part of an item or entry.
+    if expected
+        .iter()
+        .any(|w| w.starts_with("an item") || w.starts_with("a controller entry"))
+    {
+        expected.retain(|w| w != "`#`" && w != "an attribute `#[…]`");
+    }
+    // After an operand, `as`, `.` and `[` continue it like an operator does.
+    if expected.iter().any(|w| w == "an operator") {
+        expected.retain(|w| w != "`as`" && w != "`.`" && w != "`[`" && w != "an operator");
+        expected.push("an operator".to_string());
+    }
+    // "end of file" reads best last.
+    if let Some(i) = expected.iter().position(|w| w == "end of file") {
+        let eof = expected.remove(i);
+        expected.push(eof);
     }
     let found = describe_found(text, pos);
     let end = found_end(text, pos);
@@ -197,10 +251,9 @@ fn rule_words(rule: Rule) -> Option<&'static str> {
         Rule::item => "an item (`enum`, `buffer` or `controller`)",
         Rule::doc_comment => return None,
         Rule::attribute => "an attribute `#[…]`",
-        Rule::ident | Rule::path => "a name",
+        Rule::ident => "a name",
         Rule::int_lit => "an integer",
         Rule::float_lit => "a number",
-        Rule::bool_lit => "`true` or `false`",
         Rule::string_lit => "a title string",
         Rule::type_expr | Rule::array_type => "a type",
         Rule::variant => "a variant name",
@@ -218,19 +271,10 @@ fn rule_words(rule: Rule) -> Option<&'static str> {
         Rule::assign_op => "`=`, `+=` or `-=`",
         Rule::send_arrow => "`<-`",
         Rule::arrow => "`->`",
-        Rule::expr
-        | Rule::or_expr
-        | Rule::and_expr
-        | Rule::cmp_expr
-        | Rule::add_expr
-        | Rule::mul_expr
-        | Rule::unary_expr
-        | Rule::cast_expr
-        | Rule::postfix_expr
-        | Rule::primary
-        | Rule::paren
-        | Rule::call
-        | Rule::cmd_param => "an expression",
+        Rule::expr | Rule::operand | Rule::postfix_expr | Rule::paren | Rule::name_expr => {
+            "an expression"
+        }
+        Rule::call_args => "`(`",
         Rule::op_or | Rule::op_and | Rule::op_cmp | Rule::op_add | Rule::op_mul => "an operator",
         Rule::op_unary => "an expression",
         Rule::field_access => "`.`",
@@ -240,8 +284,6 @@ fn rule_words(rule: Rule) -> Option<&'static str> {
         Rule::kw_otherwise => "`otherwise`",
         Rule::kw_as => "`as`",
         Rule::kw_same => "`same`",
-        Rule::kw_cmd => "`cmd`",
-        Rule::kw_new_command => "`new_command`",
         Rule::kw_report => "`report`",
         _ => return None,
     })
@@ -299,14 +341,37 @@ struct Builder {
 impl Builder {
     fn span(&self, p: &Pair<Rule>) -> Span {
         let s = p.as_span();
-        Span::new(self.file, s.start(), s.end())
+        // A rule that ends in a repetition keeps the whitespace pest skipped
+        // before trying it once more; a label should end at the last token.
+        let trailing = s.as_str().len() - s.as_str().trim_end().len();
+        Span::new(self.file, s.start(), s.end() - trailing)
     }
 
-    fn name(&self, p: Pair<Rule>) -> Name {
-        Name {
+    /// A user-chosen name; reserved words are refused here (see grammar.pest).
+    fn name(&mut self, p: Pair<Rule>) -> Name {
+        let name = Name {
             text: p.as_str().to_string(),
             span: self.span(&p),
+        };
+        if RESERVED.contains(&name.text.as_str()) {
+            let help = match name.text.as_str() {
+                "cmd" => "read a command parameter as `cmd.NAME`".to_string(),
+                _ => format!(
+                    "`{}` is a keyword of the language; choose another name",
+                    name.text
+                ),
+            };
+            self.diags.push(
+                Diagnostic::error(
+                    Code::Syntax,
+                    format!("`{}` is a reserved word", name.text),
+                    name.span,
+                    "reserved word used as a name",
+                )
+                .with_help(help),
+            );
         }
+        name
     }
 
     fn error(&mut self, span: Span, message: impl Into<String>, label: impl Into<String>) {
@@ -690,7 +755,7 @@ impl Builder {
             }
             _ => {
                 let mut inner = c.into_inner();
-                let place = self.postfix(inner.next().expect("place"), 0);
+                let place = self.postfix(inner.next().expect("place"), 0).0;
                 match inner.next() {
                     Some(op) => {
                         let op = match op.as_str() {
@@ -725,108 +790,178 @@ impl Builder {
         self.expr_at(p, 0)
     }
 
-    /// Build an expression at tree depth `depth`, enforcing [`MAX_EXPR_DEPTH`].
-    fn expr_at(&mut self, p: Pair<Rule>, depth: usize) -> Expr {
-        let span = self.span(&p);
-        if depth > MAX_EXPR_DEPTH {
-            self.error(
-                span,
-                format!("expression nested more than {MAX_EXPR_DEPTH} deep"),
-                "too deep",
-            );
-            return Expr {
-                kind: ExprKind::Bool(false),
-                span,
-            };
-        }
-        match p.as_rule() {
-            // `expr` is the grammar's entry point, not a user's parenthesis.
-            Rule::expr => self.expr_at(p.into_inner().next().expect("one child"), depth),
-            Rule::or_expr | Rule::and_expr | Rule::cmp_expr | Rule::add_expr | Rule::mul_expr => {
-                let mut inner = p.into_inner();
-                let first = inner.next().expect("operand");
-                let mut rest: Vec<(BinOp, Pair<Rule>)> = Vec::new();
-                while let Some(op) = inner.next() {
-                    let rhs = inner.next().expect("right operand");
-                    rest.push((bin_op(op.as_str()), rhs));
-                }
-                if rest.len() + depth > MAX_EXPR_DEPTH {
-                    return self.expr_at(first, MAX_EXPR_DEPTH + 1);
-                }
-                let n = rest.len();
-                let mut lhs = self.expr_at(first, depth + n);
-                for (i, (op, rhs)) in rest.into_iter().enumerate() {
-                    let rhs = self.expr_at(rhs, depth + n - i);
-                    let span = lhs.span.to(rhs.span);
-                    lhs = Expr {
-                        kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
-                        span,
-                    };
-                }
-                lhs
-            }
-            Rule::unary_expr => {
-                let mut ops = Vec::new();
-                let mut operand = None;
-                for c in p.into_inner() {
-                    match c.as_rule() {
-                        Rule::op_unary => ops.push((c.as_str() == "!", self.span(&c))),
-                        _ => operand = Some(c),
-                    }
-                }
-                if ops.len() + depth > MAX_EXPR_DEPTH {
-                    return self.expr_at(operand.expect("operand"), MAX_EXPR_DEPTH + 1);
-                }
-                let mut e = self.expr_at(operand.expect("operand"), depth + ops.len());
-                for (not, op_span) in ops.into_iter().rev() {
-                    let span = op_span.to(e.span);
-                    let op = if not { UnOp::Not } else { UnOp::Neg };
-                    e = Expr {
-                        kind: ExprKind::Unary(op, Box::new(e)),
-                        span,
-                    };
-                }
-                e
-            }
-            Rule::cast_expr => {
-                let mut inner = p.into_inner();
-                let first = inner.next().expect("operand");
-                let types: Vec<Name> = inner
-                    .filter(|c| c.as_rule() == Rule::ident)
-                    .map(|c| self.name(c))
-                    .collect();
-                if types.len() + depth > MAX_EXPR_DEPTH {
-                    return self.expr_at(first, MAX_EXPR_DEPTH + 1);
-                }
-                let mut e = self.postfix(first, depth + types.len());
-                for ty in types {
-                    let span = e.span.to(ty.span);
-                    e = Expr {
-                        kind: ExprKind::Cast(Box::new(e), ty),
-                        span,
-                    };
-                }
-                e
-            }
-            Rule::postfix_expr => self.postfix(p, depth),
-            _ => self.primary(p, depth),
+    fn too_deep(&mut self, span: Span) -> Expr {
+        self.error(
+            span,
+            format!("expression nested more than {MAX_EXPR_DEPTH} deep"),
+            "too deep",
+        );
+        self.diags.last_mut().expect("just pushed").help = Some(
+            "split it: compute parts in earlier rows' jobs into `var`s, or in a hook".to_string(),
+        );
+        Expr {
+            kind: ExprKind::Bool(false),
+            span,
         }
     }
 
-    fn postfix(&mut self, p: Pair<Rule>, depth: usize) -> Expr {
+    /// Build an expression whose root sits at tree depth `depth`. Operator
+    /// chains are folded by precedence climbing with explicit stacks, and
+    /// every node's depth is bounded by [`MAX_EXPR_DEPTH`], so no input can
+    /// make this (or the type checker after it) recurse without limit.
+    fn expr_at(&mut self, p: Pair<Rule>, depth: usize) -> Expr {
+        let span = self.span(&p);
+        if depth > MAX_EXPR_DEPTH {
+            return self.too_deep(span);
+        }
+        let mut operands: Vec<(Expr, usize)> = Vec::new();
+        let mut ops: Vec<BinOp> = Vec::new();
+        let mut failed = false;
+        let reduce = |operands: &mut Vec<(Expr, usize)>, op: BinOp| {
+            let (r, dr) = operands.pop().expect("right operand");
+            let (l, dl) = operands.pop().expect("left operand");
+            let span = l.span.to(r.span);
+            let d = dl.max(dr) + 1;
+            operands.push((
+                Expr {
+                    kind: ExprKind::Binary(op, Box::new(l), Box::new(r)),
+                    span,
+                },
+                d,
+            ));
+            d
+        };
+        for c in p.into_inner() {
+            if c.as_rule() == Rule::operand {
+                let (e, d) = self.operand(c, depth);
+                operands.push((e, d));
+                continue;
+            }
+            let op = bin_op(c.as_str());
+            // Left-associative: reduce while the stacked operator binds at least as tightly.
+            while let Some(&top) = ops.last() {
+                if top.precedence() < op.precedence() {
+                    break;
+                }
+                ops.pop();
+                if reduce(&mut operands, top) + depth > MAX_EXPR_DEPTH {
+                    failed = true;
+                }
+            }
+            ops.push(op);
+            if failed {
+                break;
+            }
+        }
+        if failed {
+            return self.too_deep(span);
+        }
+        while let Some(op) = ops.pop() {
+            if reduce(&mut operands, op) + depth > MAX_EXPR_DEPTH {
+                return self.too_deep(span);
+            }
+        }
+        operands.pop().expect("an expression has an operand").0
+    }
+
+    /// `op_unary* postfix (as T)*`; returns the node and its height.
+    fn operand(&mut self, p: Pair<Rule>, depth: usize) -> (Expr, usize) {
+        let mut prefixes = Vec::new();
+        let mut base = None;
+        let mut casts = Vec::new();
+        for c in p.into_inner() {
+            match c.as_rule() {
+                Rule::op_unary => prefixes.push((c.as_str() == "!", self.span(&c))),
+                Rule::postfix_expr => base = Some(c),
+                Rule::ident => casts.push(c),
+                _ => {}
+            }
+        }
+        let wrappers = prefixes.len() + casts.len();
+        let base = base.expect("operand has a base");
+        if wrappers + depth > MAX_EXPR_DEPTH {
+            let span = self.span(&base);
+            return (self.too_deep(span), 1);
+        }
+        let (mut e, mut h) = self.postfix(base, depth + wrappers);
+        for ty in casts {
+            let ty = self.name(ty);
+            let span = e.span.to(ty.span);
+            e = Expr {
+                kind: ExprKind::Cast(Box::new(e), ty),
+                span,
+            };
+            h += 1;
+        }
+        for (not, op_span) in prefixes.into_iter().rev() {
+            let span = op_span.to(e.span);
+            let op = if not { UnOp::Not } else { UnOp::Neg };
+            e = Expr {
+                kind: ExprKind::Unary(op, Box::new(e)),
+                span,
+            };
+            h += 1;
+        }
+        (e, h)
+    }
+
+    fn postfix(&mut self, p: Pair<Rule>, depth: usize) -> (Expr, usize) {
         let mut inner = p.into_inner();
         let first = inner.next().expect("primary");
         let suffixes: Vec<Pair<Rule>> = inner.collect();
         if suffixes.len() + depth > MAX_EXPR_DEPTH {
-            return self.expr_at(first, MAX_EXPR_DEPTH + 1);
+            let span = self.span(&first);
+            return (self.too_deep(span), 1);
         }
-        let mut e = self.primary(first, depth + suffixes.len());
+        let (mut e, mut h) = self.primary(first, depth + suffixes.len());
+        let mut suffixes = suffixes.into_iter().peekable();
+        // `cmd.P`: the command parameter, not a field of something named `cmd`.
+        if matches!(&e.kind, ExprKind::Path(None, n) if n.text == "cmd") {
+            let param = suffixes
+                .next_if(|s| {
+                    s.clone()
+                        .into_inner()
+                        .next()
+                        .is_some_and(|c| c.as_rule() == Rule::ident)
+                })
+                .map(|s| s.into_inner().next().expect("field name"));
+            match param {
+                Some(p) => {
+                    let span = e.span.to(self.span(&p));
+                    e = Expr {
+                        kind: ExprKind::CmdParam(self.name(p)),
+                        span,
+                    };
+                }
+                None => {
+                    let span = e.span;
+                    self.error(
+                        span,
+                        "`cmd` alone is not a value",
+                        "expected `cmd.PARAMETER`",
+                    );
+                    self.diags.last_mut().expect("just pushed").help =
+                        Some("read a parameter of the current command as `cmd.NAME`".to_string());
+                }
+            }
+        }
         for s in suffixes {
             let sspan = self.span(&s);
             let span = e.span.to(sspan);
             let c = s.into_inner().next().expect("suffix has one child");
             e = match c.as_rule() {
-                Rule::ident | Rule::kw_status | Rule::kw_error => Expr {
+                // `status` and `error` are keywords but valid after a dot.
+                Rule::kw_status | Rule::kw_error => Expr {
+                    kind: ExprKind::Field(
+                        Box::new(e),
+                        Name {
+                            text: c.as_str().to_string(),
+                            span: self.span(&c),
+                        },
+                    ),
+                    span,
+                },
+                Rule::ident => Expr {
                     kind: ExprKind::Field(Box::new(e), self.name(c)),
                     span,
                 },
@@ -838,17 +973,14 @@ impl Builder {
                     }
                 }
             };
+            h += 1;
         }
-        e
+        (e, h)
     }
 
-    fn primary(&mut self, p: Pair<Rule>, depth: usize) -> Expr {
-        let p = if p.as_rule() == Rule::primary {
-            p.into_inner().next().expect("primary has one child")
-        } else {
-            p
-        };
+    fn primary(&mut self, p: Pair<Rule>, depth: usize) -> (Expr, usize) {
         let span = self.span(&p);
+        let mut height = 1;
         let kind = match p.as_rule() {
             Rule::float_lit => match p.as_str().replace('_', "").parse::<f64>() {
                 Ok(v) if v.is_finite() => ExprKind::Float(v),
@@ -868,34 +1000,80 @@ impl Builder {
                     ExprKind::Int(0)
                 }
             },
-            Rule::bool_lit => ExprKind::Bool(p.as_str() == "true"),
-            Rule::kw_new_command => ExprKind::NewCommand,
-            Rule::kw_state_cycles => ExprKind::StateCycles,
-            Rule::kw_plan_cycles => ExprKind::PlanCycles,
-            Rule::cmd_param => {
-                let n = p.into_inner().nth(1).expect("parameter name");
-                ExprKind::CmdParam(self.name(n))
-            }
-            Rule::call => {
+            Rule::name_expr => {
                 let mut inner = p.into_inner();
-                let name = self.name(inner.next().expect("hook name"));
-                let args = inner.map(|a| self.expr_at(a, depth + 1)).collect();
-                ExprKind::Call(name, args)
-            }
-            Rule::path => {
-                let mut names: Vec<Name> = p.into_inner().map(|n| self.name(n)).collect();
-                let last = names.pop().expect("path has a name");
-                ExprKind::Path(names.pop(), last)
+                let first = inner.next().expect("a name");
+                match (first.as_str(), inner.peek().map(|c| c.as_rule())) {
+                    ("true", None) => ExprKind::Bool(true),
+                    ("false", None) => ExprKind::Bool(false),
+                    ("new_command", None) => ExprKind::NewCommand,
+                    ("state_cycles", None) => ExprKind::StateCycles,
+                    ("plan_cycles", None) => ExprKind::PlanCycles,
+                    // Left for `postfix`, which turns `cmd.P` into a parameter.
+                    ("cmd", None) => ExprKind::Path(
+                        None,
+                        Name {
+                            text: "cmd".to_string(),
+                            span,
+                        },
+                    ),
+                    (_, Some(Rule::call_args)) => {
+                        let name = self.name(first);
+                        let args = inner
+                            .next()
+                            .expect("arguments")
+                            .into_inner()
+                            .map(|a| self.expr_at(a, depth + 1))
+                            .collect();
+                        height = 2;
+                        ExprKind::Call(name, args)
+                    }
+                    (_, Some(_)) => {
+                        let qualifier = self.name(first);
+                        let name = self.name(inner.next().expect("variant"));
+                        ExprKind::Path(Some(qualifier), name)
+                    }
+                    (_, None) => ExprKind::Path(None, self.name(first)),
+                }
             }
             Rule::paren => {
                 let e = self.expr_at(p.into_inner().next().expect("inner"), depth + 1);
+                height = 2;
                 ExprKind::Paren(Box::new(e))
             }
-            _ => return self.expr_at(p, depth),
+            _ => unreachable!("primary alternatives are listed in the grammar"),
         };
-        Expr { kind, span }
+        (Expr { kind, span }, height)
     }
 }
+
+/// Words of the language that cannot name anything (LANGUAGE.md §1).
+pub const RESERVED: [&str; 24] = [
+    "enum",
+    "buffer",
+    "controller",
+    "level",
+    "subordinates",
+    "reads",
+    "writes",
+    "command",
+    "status",
+    "error",
+    "var",
+    "hook",
+    "plan",
+    "when",
+    "otherwise",
+    "report",
+    "true",
+    "false",
+    "same",
+    "as",
+    "new_command",
+    "cmd",
+    "state_cycles",
+    "plan_cycles",
+];
 
 fn bin_op(s: &str) -> BinOp {
     match s {

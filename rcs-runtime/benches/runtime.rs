@@ -7,7 +7,12 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use rcs_runtime::{Controller, CycleContext, Executive, ExecutiveConfig, GlobalMemory};
+use rcs_runtime::{
+    Controller, CycleContext, Executive, ExecutiveConfig, GlobalMemory, Operator, VerbId,
+};
+
+#[path = "../tests/common/mod.rs"]
+mod common;
 
 /// A buffer of `N` words; its contents only matter for their size.
 #[derive(Clone, Copy)]
@@ -101,10 +106,51 @@ fn exec_bench(c: &mut Criterion) {
     g.finish();
 }
 
+/// A realistic cycle: three hand-written controllers (SM -> PR -> TB) with
+/// Global Memory reads and writes, handshake and plan bookkeeping, a new
+/// command every 20 cycles.
+fn hierarchy_bench(c: &mut Criterion) {
+    let mut g = c.benchmark_group("hierarchy_3_controllers");
+    g.throughput(Throughput::Elements(3));
+    for measure in [true, false] {
+        let gm = GlobalMemory::new();
+        let cfg = ExecutiveConfig::new("bench", Duration::from_millis(1)).with_measure(measure);
+        let mut e = Executive::new(cfg).unwrap();
+        e.add(Box::new(
+            common::Relay::new(&gm, "SM", Some("PR"), 0).unwrap(),
+        ))
+        .unwrap();
+        e.add(Box::new(
+            common::Relay::new(&gm, "PR", Some("TB"), 0).unwrap(),
+        ))
+        .unwrap();
+        e.add(Box::new(common::Relay::new(&gm, "TB", None, 5).unwrap()))
+            .unwrap();
+        let mut op = Operator::<VerbId>::connect(&gm, "SM").unwrap();
+        let label = if measure {
+            "cycle (timing on)"
+        } else {
+            "cycle (timing off)"
+        };
+        let mut n = 0u32;
+        g.bench_function(label, |b| {
+            b.iter(|| {
+                if n % 20 == 0 {
+                    op.command(common::GO);
+                }
+                n = n.wrapping_add(1);
+                e.step()
+            })
+        });
+    }
+    g.finish();
+}
+
 fn benches(c: &mut Criterion) {
     gm_bench::<8>(c); // 64 bytes
     gm_bench::<64>(c); // 512 bytes
     exec_bench(c);
+    hierarchy_bench(c);
 }
 
 criterion_group!(group, benches);

@@ -248,6 +248,11 @@ impl ExecutiveHandle {
     pub fn stop(&self) {
         self.shared.stop.store(true, Ordering::SeqCst);
     }
+    /// Withdraw a stop request, so that [`Executive::run`] can be entered
+    /// again.
+    pub fn clear_stop(&self) {
+        self.shared.stop.store(false, Ordering::SeqCst);
+    }
     /// Whether the executive is paused.
     pub fn is_paused(&self) -> bool {
         self.shared.paused.load(Ordering::SeqCst)

@@ -12,7 +12,7 @@
 //! [`Reader`]s are `Clone` and can be had any number of times. Readers and
 //! writers may live on different threads (several executives share one
 //! Global Memory); a read never blocks the writer and never returns a torn
-//! value (see [`crate::seqlock`] for how).
+//! value (the private `seqlock` module explains how).
 //!
 //! Looking buffers up by name happens at setup and takes a lock; reading and
 //! writing through the handles afterwards is lock-free and allocation-free.

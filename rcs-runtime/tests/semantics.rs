@@ -361,6 +361,9 @@ fn pause_stops_cycles_go_resumes() {
     h.stop();
     e.run();
     assert_eq!(e.cycle(), 5, "a stop before run returns at once");
+    h.clear_stop();
+    e.run_for(2);
+    assert_eq!(e.cycle(), 7);
 }
 
 #[test]

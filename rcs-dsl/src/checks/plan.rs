@@ -128,6 +128,11 @@ pub(crate) fn check_entry(p: &Plan, sink: &mut Sink) {
         if r.is_otherwise() {
             continue;
         }
+        // An entry row from a state other than S0 never matches: it is
+        // `unreachable_row`'s (or `unreachable_state`'s) finding, not this one's.
+        if r.is_entry && matches!(r.from, From::State(s) if s != StateId::S0) {
+            continue;
+        }
         if !r.is_entry {
             first_ordinary.get_or_insert(r);
         } else if let Some(o) = first_ordinary {

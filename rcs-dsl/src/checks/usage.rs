@@ -174,13 +174,11 @@ pub(crate) fn check_unused(ir: &Ir, sink: &mut Sink) {
         }
         for b in c.reads.iter().chain(&c.writes) {
             if !buffer_used[b.index()] {
-                let span = c.span;
                 let name = &ir.buffers[b.index()].name;
-                let _ = span;
                 report(
                     "buffer",
                     name,
-                    buffer_decl_span(ir, c, name),
+                    buffer_decl_span(c, *b),
                     "remove the `reads`/`writes` line, or use the buffer in a plan",
                 );
             }
@@ -218,7 +216,10 @@ pub(crate) fn check_unused(ir: &Ir, sink: &mut Sink) {
     }
 }
 
-/// The controller's span stands in when no finer one is kept.
-fn buffer_decl_span(_ir: &Ir, c: &crate::ir::Controller, _name: &str) -> crate::source::Span {
-    c.name_span
+/// Where `c` declares buffer `b` (`reads NAME` / `writes NAME`).
+fn buffer_decl_span(c: &crate::ir::Controller, b: crate::ir::BufferId) -> crate::source::Span {
+    c.buffer_spans
+        .iter()
+        .find(|(id, _)| *id == b)
+        .map_or(c.name_span, |(_, span)| *span)
 }

@@ -55,7 +55,14 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
         }
         let mut claim = |name: &ast::Name, what: &str, diags: &mut Diagnostics| -> bool {
             if let Some((_, first)) = values.iter().find(|(v, _)| *v == name.text) {
-                diags.push(duplicate(what, &name.text, name.span, *first));
+                // `reads`, `writes` and `subordinates` were collected first;
+                // the diagnostic goes on whichever declaration comes later.
+                let (later, earlier) = if first.start > name.span.start {
+                    (*first, name.span)
+                } else {
+                    (name.span, *first)
+                };
+                diags.push(duplicate(what, &name.text, later, earlier));
                 false
             } else {
                 values.push((name.text.clone(), name.span));
@@ -193,6 +200,19 @@ pub(super) fn lower_controller_body(
     let mut plan_of: Vec<Option<PlanId>> = vec![None; ir.controllers[id.index()].commands.len()];
     {
         let ctrl = &ir.controllers[id.index()];
+        // Hooks whose declared return type did not resolve (already reported).
+        let unresolved_hooks: Vec<String> = c
+            .entries
+            .iter()
+            .filter_map(|e| match &e.kind {
+                ast::EntryKind::Hook {
+                    name, ret: Some(t), ..
+                } if resolve_type(g, t, &mut Diagnostics::new()).is_none() => {
+                    Some(name.text.clone())
+                }
+                _ => None,
+            })
+            .collect();
         let mut cx = Cx {
             g,
             ir,
@@ -200,6 +220,7 @@ pub(super) fn lower_controller_body(
             c: ctrl,
             plan_cmd: None,
             const_ctx: true,
+            unresolved_hooks,
             diags,
         };
         for e in &c.entries {
@@ -273,6 +294,8 @@ struct Cx<'a, 'g> {
     plan_cmd: Option<CommandId>,
     /// In a var initialiser: only constants are allowed.
     const_ctx: bool,
+    /// Hooks whose return type did not resolve: their calls fit everywhere.
+    unresolved_hooks: Vec<String>,
     diags: &'a mut Diagnostics,
 }
 
@@ -325,10 +348,9 @@ impl Cx<'_, '_> {
         if let Some(i) = c.hooks.iter().position(|h| h.name == name) {
             return Some(Value::Hook(HookId(i as u32)));
         }
-        if let Some(s) = c
-            .subordinates
+        if c.subordinates
             .iter()
-            .find(|s| self.ir.controllers[s.index()].name == name)
+            .any(|s| self.ir.controllers[s.index()].name == name)
         {
             return Some(Value::Sub);
         }
@@ -734,16 +756,32 @@ impl Cx<'_, '_> {
                 }
             }
             Some(Type::Status(cid)) => {
-                if let Some(si) = self.ir.controllers[cid.index()]
-                    .statuses
-                    .iter()
-                    .position(|s| s.name == name.text)
-                {
+                let ctrl = &self.ir.controllers[cid.index()];
+                if let Some(si) = ctrl.statuses.iter().position(|s| s.name == name.text) {
                     return (
                         mk(ExprKind::Status(StatusId(si as u32)), Type::Status(*cid)),
                         Ty::Known(Type::Status(*cid)),
                     );
                 }
+                // Compared with `X.status`: say what X can report.
+                self.diags.push(
+                    Diagnostic::error(
+                        Code::UnknownName,
+                        format!("controller `{}` has no status `{}`", ctrl.name, name.text),
+                        name.span,
+                        "no such status",
+                    )
+                    .with_help(format!(
+                        "the statuses of `{}` are: {}",
+                        ctrl.name,
+                        ctrl.statuses
+                            .iter()
+                            .map(|s| s.name.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )),
+                );
+                return (err_expr(span), Ty::Err);
             }
             _ => {}
         }
@@ -846,7 +884,7 @@ impl Cx<'_, '_> {
                     .with_help(format!("declare it: `hook {}(…) -> T`", name.text)),
                 );
                 for a in args {
-                    self.infer(a, None);
+                    self.infer_untyped(a);
                 }
                 return (err_expr(span), Ty::Err);
             }
@@ -874,20 +912,23 @@ impl Cx<'_, '_> {
                 .with_secondary(h.span, "hook declared here"),
             );
             for a in args {
-                self.infer(a, None);
+                self.infer_untyped(a);
             }
             return (err_expr(span), Ty::Err);
         }
         let mut out = Vec::new();
         for (a, p) in args.iter().zip(h.params.clone()) {
             if p.ty == Type::Unit {
-                self.infer(a, None);
+                self.infer_untyped(a);
                 out.push(err_expr(a.span));
             } else {
                 out.push(self.check(a, &p.ty));
             }
         }
         let ret = h.ret.clone();
+        if self.unresolved_hooks.contains(&h.name) {
+            return (err_expr(span), Ty::Err);
+        }
         (
             Expr {
                 kind: ExprKind::Call(hook, out),
@@ -905,6 +946,22 @@ impl Cx<'_, '_> {
                 if let Some((ItemRef::Controller(cid), _)) = self.g.names.get(x.text.as_str()) {
                     return self.sub_prop(*cid, x, field, span);
                 }
+                let sub_prop = ["status", "done", "executing", "error", "stale_cycles"];
+                if self.value(&x.text).is_none() && sub_prop.contains(&field.text.as_str()) {
+                    self.diags.push(
+                        Diagnostic::error(
+                            Code::UnknownName,
+                            format!("no controller named `{}`", x.text),
+                            x.span,
+                            "not declared",
+                        )
+                        .with_help(format!(
+                            "`.{}` reads the status of a subordinate: a controller declared in this plan set and listed in `{}`'s `subordinates`",
+                            field.text, self.c.name
+                        )),
+                    );
+                    return (err_expr(span), Ty::Err);
+                }
             }
         }
         let (b, bt) = self.infer(base, None);
@@ -915,6 +972,9 @@ impl Cx<'_, '_> {
                 match bty.fields.iter().position(|f| f.name == field.text) {
                     Some(fi) => {
                         let ty = bty.fields[fi].ty.clone();
+                        if ty == Type::Unit {
+                            return (err_expr(span), Ty::Err); // its type did not resolve
+                        }
                         (
                             Expr {
                                 kind: ExprKind::Field(Box::new(b), fi as u32),
@@ -1093,12 +1153,10 @@ impl Cx<'_, '_> {
                 let (mut a, mut ta, mut b, mut tb);
                 if left_first {
                     (a, ta) = self.infer(l, None);
-                    let hint = known(&ta);
-                    (b, tb) = self.infer(r, hint.as_ref());
+                    (b, tb) = self.infer_beside(r, &ta);
                 } else {
                     (b, tb) = self.infer(r, None);
-                    let hint = known(&tb);
-                    (a, ta) = self.infer(l, hint.as_ref());
+                    (a, ta) = self.infer_beside(l, &tb);
                 }
                 let Some(t) = unify(&ta, &tb) else {
                     let (na, nb) = (self.ty_name(&ta), self.ty_name(&tb));
@@ -1110,11 +1168,22 @@ impl Cx<'_, '_> {
                             "mismatched operand types",
                         )
                         .with_secondary(l.span, na.clone())
-                        .with_secondary(r.span, nb.clone())
-                        .with_help(
-                            "no implicit conversions: use `as` to convert between numeric types",
-                        ),
+                        .with_secondary(r.span, nb.clone()),
                     );
+                    let numeric = |t: &Ty| {
+                        matches!(
+                            t,
+                            Ty::IntLit | Ty::FloatLit | Ty::Known(Type::Int(_) | Type::Float(_))
+                        )
+                    };
+                    let status = |t: &Ty| matches!(t, Ty::Known(Type::Status(_)));
+                    if numeric(&ta) && numeric(&tb) {
+                        self.help_last(
+                            "no implicit conversions: use `as` to convert between numeric types",
+                        );
+                    } else if status(&ta) && status(&tb) {
+                        self.help_last("each controller has its own statuses: compare each one with a status name, as in `X.status == DONE`");
+                    }
                     return (err_expr(span), Ty::Err);
                 };
                 if t == Ty::Err {
@@ -1176,6 +1245,24 @@ impl Cx<'_, '_> {
                     )
                 }
             }
+        }
+    }
+
+    /// Infer an operand whose expected type is unknown because of an error
+    /// already reported: a bare name that is no value here (most likely a
+    /// variant or status) then gets the error type instead of a second report.
+    fn infer_untyped(&mut self, e: &ast::Expr) -> (Expr, Ty) {
+        if self.is_bare_unknown(e) {
+            return (err_expr(e.span), Ty::Err);
+        }
+        self.infer(e, None)
+    }
+
+    /// Infer the operand beside one of type `other` (the other side of `==`).
+    fn infer_beside(&mut self, e: &ast::Expr, other: &Ty) -> (Expr, Ty) {
+        match other {
+            Ty::Err => self.infer_untyped(e),
+            t => self.infer(e, known(t).as_ref()),
         }
     }
 
@@ -1376,7 +1463,7 @@ impl Cx<'_, '_> {
                         ),
                         "not a number".to_string(),
                     );
-                    self.infer(value, None);
+                    self.infer_untyped(value);
                     return None;
                 }
                 let v = self.check(value, &p.ty);
@@ -1405,7 +1492,7 @@ impl Cx<'_, '_> {
     ) -> Option<Job> {
         let infer_all = |cx: &mut Self| {
             for (_, a) in args {
-                cx.infer(a, None);
+                cx.infer_untyped(a);
             }
         };
         let sid = match self
@@ -1482,7 +1569,7 @@ impl Cx<'_, '_> {
                         )
                         .with_secondary(command.span, "command declared here"),
                     );
-                    self.infer(a, None);
+                    self.infer_untyped(a);
                     ok = false;
                 }
                 Some(pi) => {
@@ -1496,14 +1583,14 @@ impl Cx<'_, '_> {
                             )
                             .with_secondary(first, "first given here"),
                         );
-                        self.infer(a, None);
+                        self.infer_untyped(a);
                         ok = false;
                         continue;
                     }
                     seen[pi] = Some(n.span);
                     let ty = command.params[pi].ty.clone();
                     slots[pi] = Some(if ty == Type::Unit {
-                        self.infer(a, None).0
+                        self.infer_untyped(a).0
                     } else {
                         self.check(a, &ty)
                     });
@@ -1606,6 +1693,9 @@ impl Cx<'_, '_> {
                         match bty.fields.iter().position(|x| x.name == f.text) {
                             Some(fi) => {
                                 p.ty = bty.fields[fi].ty.clone();
+                                if p.ty == Type::Unit {
+                                    return None; // its type did not resolve; already reported
+                                }
                                 p.path.push(Projection::Field(fi as u32));
                                 p.span = e.span;
                                 Some(p)

@@ -258,9 +258,10 @@ fn lower_buffer_types(g: &Globals, ir: &mut Ir, diags: &mut Diagnostics) {
                 diags.push(duplicate("field", &f.name.text, f.name.span, first.span));
                 continue;
             }
-            // An unresolved field type is reported; the field is kept as bool
-            // so uses of it do not cascade into unknown-field errors.
-            let ty = resolve_type(g, &f.ty, diags).unwrap_or(Type::Bool);
+            // An unresolved field type is reported; the field is kept (as
+            // `Unit`, which its uses read as "already reported") so that they
+            // cascade neither into unknown-field errors nor type mismatches.
+            let ty = resolve_type(g, &f.ty, diags).unwrap_or(Type::Unit);
             fields.push(FieldDef {
                 name: f.name.text.clone(),
                 docs: f.docs.clone(),
@@ -297,7 +298,7 @@ fn check_buffer_recursion(ir: &Ir, diags: &mut Diagnostics) {
             }
         }
     }
-    for scc in petgraph::algo::tarjan_scc(&graph) {
+    for scc in petgraph::algo::kosaraju_scc(&graph) {
         let cyclic = scc.len() > 1 || graph.contains_edge(scc[0], scc[0]);
         if cyclic {
             let first = scc.iter().map(|n| n.index()).min().expect("non-empty");
@@ -354,6 +355,7 @@ fn lower_controller_headers<'a>(
             name_span: c.name.span,
             subordinate_spans: Vec::new(),
             subordinates_lists: Vec::new(),
+            buffer_spans: Vec::new(),
         });
     }
     // Where each controller was named as a subordinate, for multiple_supervisors.
@@ -443,6 +445,10 @@ fn lower_controller_headers<'a>(
                                 .with_secondary(earlier, "first supervisor names it here")
                                 .with_help("each controller has one supervisor (§3.5); move the command path through one of them"),
                             );
+                            // Still a subordinate here, so that this plan's
+                            // commands and status reads do not cascade.
+                            ir.controllers[i].subordinates.push(sub);
+                            ir.controllers[i].subordinate_spans.push(n.span);
                             continue;
                         }
                         ir.controllers[sub.index()].supervisor = Some(id);
@@ -492,9 +498,20 @@ fn lower_controller_headers<'a>(
                                     .with_secondary(first, "first declared here")
                                     .with_help("a Global Memory buffer has one type across the plan set"),
                                 );
-                                continue;
+                                // Inside this controller the buffer has the type
+                                // it declares: a stand-in entry keeps its uses
+                                // from cascading (no IR is produced anyway).
+                                ir.buffers.push(Buffer {
+                                    name: name.text.clone(),
+                                    ty: bty,
+                                    writer: None,
+                                    readers: Vec::new(),
+                                });
+                                buffer_decl.push((name.span, None));
+                                BufferId(ir.buffers.len() as u32 - 1)
+                            } else {
+                                BufferId(b as u32)
                             }
-                            BufferId(b as u32)
                         }
                         None => {
                             ir.buffers.push(Buffer {
@@ -509,7 +526,12 @@ fn lower_controller_headers<'a>(
                     };
                     let ctrl = &mut ir.controllers[i];
                     if ctrl.reads.contains(&bid) || ctrl.writes.contains(&bid) {
-                        let first = buffer_decl[bid.index()].0;
+                        // This controller's own earlier declaration.
+                        let first = ctrl
+                            .buffer_spans
+                            .iter()
+                            .find(|(b, _)| *b == bid)
+                            .map_or(buffer_decl[bid.index()].0, |(_, s)| *s);
                         diags.push(duplicate("buffer", &name.text, name.span, first));
                         continue;
                     }
@@ -529,6 +551,9 @@ fn lower_controller_headers<'a>(
                                 .with_secondary(first, "first writer")
                                 .with_help("Global Memory has one writer per buffer (§3.8.5); let the other controller `reads` it"),
                             );
+                            // Still writable here, so that its uses do not cascade.
+                            ir.controllers[i].writes.push(bid);
+                            ir.controllers[i].buffer_spans.push((bid, name.span));
                             continue;
                         }
                         ir.buffers[bid.index()].writer = Some(id);
@@ -538,6 +563,7 @@ fn lower_controller_headers<'a>(
                         ir.buffers[bid.index()].readers.push(id);
                         ir.controllers[i].reads.push(bid);
                     }
+                    ir.controllers[i].buffer_spans.push((bid, name.span));
                 }
                 _ => {}
             }
@@ -554,7 +580,9 @@ fn sub_span(c: &ast::ControllerDef, name: &str) -> Option<Span> {
     })
 }
 
-/// With one supervisor each, a cycle is a ring of controllers each above the next.
+/// With one supervisor each, a cycle is a ring of controllers each above the
+/// next. Kosaraju rather than Tarjan: petgraph's Tarjan recurses per node,
+/// and a long chain of controllers must not exhaust the stack.
 fn check_hierarchy_cycles(ir: &Ir, diags: &mut Diagnostics) {
     let mut graph = DiGraph::<(), ()>::new();
     for _ in &ir.controllers {
@@ -565,7 +593,7 @@ fn check_hierarchy_cycles(ir: &Ir, diags: &mut Diagnostics) {
             graph.add_edge(NodeIndex::new(i), NodeIndex::new(s.index()), ());
         }
     }
-    for scc in petgraph::algo::tarjan_scc(&graph) {
+    for scc in petgraph::algo::kosaraju_scc(&graph) {
         if scc.len() < 2 {
             continue;
         }

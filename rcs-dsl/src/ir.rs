@@ -106,6 +106,9 @@ pub struct EnumDef {
     /// Invariant: at least one variant; the first is the zero value.
     pub variants: Vec<Variant>,
     pub span: Span,
+    /// The name in the declaration, for diagnostics.
+    #[serde(skip)]
+    pub name_span: Span,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -122,6 +125,9 @@ pub struct BufferType {
     pub docs: Vec<String>,
     pub fields: Vec<FieldDef>,
     pub span: Span,
+    /// The name in the declaration, for diagnostics.
+    #[serde(skip)]
+    pub name_span: Span,
 }
 
 #[derive(Clone, Debug, Serialize)]

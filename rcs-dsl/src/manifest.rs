@@ -101,12 +101,12 @@ pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>>
                 Some(loc) => spanned(&loc),
                 None => Span::new(id, 0, 0),
             };
-            let message = first_line(&e.to_string());
+            let (message, label) = describe_yaml_error(&first_line(&e.to_string()));
             return Err(vec![Diagnostic::error(
                 Code::Manifest,
                 format!("invalid `rcs.yaml`: {message}"),
                 span,
-                "here",
+                label,
             )
             .with_help(
                 "known keys: system, plans, limits {max_rules_per_plan, max_subordinates}, \
@@ -156,8 +156,8 @@ pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>>
                 Diagnostic::error(
                     Code::Manifest,
                     format!("unknown lint `{name}` in `lints`"),
-                    span,
-                    "this lint's level",
+                    key_span(file, id, span, &name),
+                    "not a lint",
                 )
                 .with_help(format!(
                     "the lints are: {}",
@@ -244,6 +244,39 @@ fn is_identifier(s: &str) -> bool {
     let mut chars = s.chars();
     matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+/// The key of a `key: value` pair, found on the value's line before it
+/// (the YAML library gives spans for values only); the value's span if not found.
+fn key_span(file: &SourceFile, id: FileId, value: Span, key: &str) -> Span {
+    let start = value.start as usize;
+    let line_start = file.text[..start].rfind('\n').map_or(0, |i| i + 1);
+    match file.text[line_start..start].rfind(key) {
+        Some(i) => Span::new(id, line_start + i, line_start + i + key.len()),
+        None => value,
+    }
+}
+
+/// The YAML library's message in the manifest's words, and a label for it.
+fn describe_yaml_error(message: &str) -> (String, &'static str) {
+    // The location is shown by the snippet; drop the library's copy of it.
+    let message = match message.rfind(" at line ") {
+        Some(i) if message[i..].contains(", column ") => &message[..i],
+        _ => message,
+    };
+    if let Some(rest) = message.strip_prefix("unknown field ") {
+        return (
+            format!(
+                "unknown key {}",
+                rest.replace(", expected one of ", "; expected one of: ")
+            ),
+            "unknown key",
+        );
+    }
+    if message.starts_with("invalid u32") || message.starts_with("invalid u64") {
+        return ("expected a whole number".to_string(), "not a whole number");
+    }
+    (message.to_string(), "here")
 }
 
 fn first_line(s: &str) -> String {

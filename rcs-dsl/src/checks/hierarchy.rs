@@ -11,27 +11,28 @@ pub(crate) fn check_span_of_control(ir: &Ir, sink: &mut Sink) {
         if c.subordinates.len() <= max {
             continue;
         }
-        let span = c
-            .subordinates_lists
-            .iter()
-            .copied()
-            .reduce(|a, b| a.to(b))
-            .unwrap_or(c.name_span);
+        let (first, more) = match c.subordinates_lists.split_first() {
+            Some((first, more)) => (*first, more),
+            None => (c.name_span, &[][..]),
+        };
+        let mut d = Diagnostic::lint(
+            Lint::SpanOfControl,
+            format!(
+                "`{}` supervises {} controllers; the limit is {max}",
+                c.name,
+                c.subordinates.len()
+            ),
+            first,
+            "too many subordinates",
+        );
+        for span in more {
+            d = d.with_secondary(*span, "more subordinates here");
+        }
         sink.lint(
             Some(c),
             None,
-            Diagnostic::lint(
-                Lint::SpanOfControl,
-                format!(
-                    "`{}` supervises {} controllers; the limit is {max}",
-                    c.name,
-                    c.subordinates.len()
-                ),
-                span,
-                "too many subordinates",
-            )
-            .with_note("a supervisor coordinates 7±2 subordinates at most (§3.5)")
-            .with_help("group subordinates under an intermediate controller"),
+            d.with_note("a supervisor coordinates 7±2 subordinates at most (§3.5)")
+                .with_help("group subordinates under an intermediate controller"),
         );
     }
 }

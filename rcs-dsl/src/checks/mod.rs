@@ -37,12 +37,46 @@ impl Sink<'_> {
             scopes.push(&p.lints);
         }
         let level = self.levels.at(lint, &scopes);
-        let is_default =
-            level == lint.default_level() && self.levels.get(lint) == lint.default_level();
-        if let Some(d) = d.at_level(level, is_default) {
-            self.diags.push(d);
+        // Say where the level came from: the innermost attribute naming the
+        // lint, else the plan set's settings, else the default.
+        let by_attribute =
+            |lints: &[(Lint, crate::lint::Level)]| lints.iter().any(|(l, _)| *l == lint);
+        let source = match (ctrl, plan) {
+            (Some(c), Some(p)) if by_attribute(&p.lints) => {
+                Source::Attribute(format!("plan `{}`", c.commands[p.verb.index()].name))
+            }
+            (Some(c), _) if by_attribute(&c.lints) => {
+                Source::Attribute(format!("controller `{}`", c.name))
+            }
+            _ if self.levels.get(lint) != lint.default_level() => Source::PlanSet,
+            _ => Source::Default,
+        };
+        let Some(mut d) = d.at_level(level, matches!(source, Source::Default)) else {
+            return;
+        };
+        let attr = format!("`#[{}({})]`", level.name(), lint.name());
+        let note = match source {
+            Source::Default => None,
+            Source::Attribute(on) => Some(format!("{attr} set by an attribute on {on}")),
+            Source::PlanSet => Some(format!(
+                "level `{}` set for the plan set (`lints:` in `rcs.yaml`, or a command-line flag)",
+                level.name()
+            )),
+        };
+        if let (Some(note), Some(last)) = (note, d.notes.last_mut()) {
+            *last = note;
         }
+        self.diags.push(d);
     }
+}
+
+/// Where a lint's level at a place comes from, for the note that says so.
+enum Source {
+    Default,
+    /// An attribute on the named controller or plan.
+    Attribute(String),
+    /// The manifest's `lints:` or a command-line flag.
+    PlanSet,
 }
 
 /// Run every check over a lowered plan set.

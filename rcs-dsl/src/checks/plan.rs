@@ -114,10 +114,13 @@ pub(crate) fn check_entry(p: &Plan, sink: &mut Sink) {
                 Code::EntryMissing,
                 "no row of this plan handles a new command",
                 p.header,
-                "no row tests `new_command`",
+                "no entry row",
             )
             .with_note(
                 "a plan starts in S0 on the cycle its command arrives (§A `check_if_new_command`)",
+            )
+            .with_note(
+                "an entry row's condition is `new_command` or `new_command && …`; under `||` or `!` it does not count",
             )
             .with_help("make the first row an entry: `*0 when new_command -> S1 { … }`"),
         );

@@ -192,7 +192,7 @@ pub(crate) fn check_unused(ir: &Ir, sink: &mut Sink) {
                 Diagnostic::lint(
                     Lint::Unused,
                     format!("enum `{}` is never used", e.name),
-                    e.span,
+                    e.name_span,
                     "declared here",
                 )
                 .with_help("remove it, or use it as a field, parameter or var type"),
@@ -207,7 +207,7 @@ pub(crate) fn check_unused(ir: &Ir, sink: &mut Sink) {
                 Diagnostic::lint(
                     Lint::Unused,
                     format!("buffer type `{}` is never used", b.name),
-                    b.span,
+                    b.name_span,
                     "declared here",
                 )
                 .with_help("remove it, or name it in a `reads` or `writes` line"),

@@ -1000,7 +1000,7 @@ impl Cx<'_, '_> {
                                     .collect::<Vec<_>>()
                                     .join(", ")
                             ))
-                            .with_secondary(bty.span, format!("`{}` declared here", bty.name)),
+                            .with_secondary(bty.name_span, format!("`{}` declared here", bty.name)),
                         );
                         (err_expr(span), Ty::Err)
                     }

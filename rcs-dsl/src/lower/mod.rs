@@ -169,6 +169,7 @@ fn lower_enums(g: &Globals, ir: &mut Ir, diags: &mut Diagnostics) {
             docs: e.outer.docs.clone(),
             variants,
             span: e.span,
+            name_span: e.name.span,
         });
     }
 }
@@ -274,6 +275,7 @@ fn lower_buffer_types(g: &Globals, ir: &mut Ir, diags: &mut Diagnostics) {
             docs: b.outer.docs.clone(),
             fields,
             span: b.span,
+            name_span: b.name.span,
         });
     }
 }
@@ -307,7 +309,7 @@ fn check_buffer_recursion(ir: &Ir, diags: &mut Diagnostics) {
                 Diagnostic::error(
                     Code::TypeMismatch,
                     format!("buffer `{}` contains itself", b.name),
-                    b.span,
+                    b.name_span,
                     "recursive buffer type",
                 )
                 .with_help(

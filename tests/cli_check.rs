@@ -1,0 +1,219 @@
+//! `rcsc check` end to end: the binary, its exit statuses (0 / 1 / 2), its
+//! output formats and its lint flags, as a user meets them.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn rcsc(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rcsc"))
+        .args(args)
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("rcsc runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// A scratch plan set in a fresh temporary folder.
+fn scratch(name: &str, files: &[(&str, &str)]) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("rcsc-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (path, body) in files {
+        let p = dir.join(path);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(p, body).unwrap();
+    }
+    dir
+}
+
+const UNUSED_VAR: &str = "controller A {\n    command GO\n    var spare: u8 = 0\n    plan GO {\n        *0 when new_command -> Done\n    }\n}\n";
+
+#[test]
+fn reference_plan_sets_check_silently() {
+    for set in ["plans/submarine", "plans/figure13"] {
+        for format in ["json", "human", "short"] {
+            let out = rcsc(&["check", set, "--message-format", format]);
+            assert_eq!(
+                out.status.code(),
+                Some(0),
+                "{set} {format}: {}",
+                text(&out.stderr)
+            );
+            assert!(
+                out.stdout.is_empty(),
+                "{set} {format}: {}",
+                text(&out.stdout)
+            );
+            assert!(
+                out.stderr.is_empty(),
+                "{set} {format}: {}",
+                text(&out.stderr)
+            );
+        }
+    }
+}
+
+#[test]
+fn several_plan_sets_and_single_files_in_one_call() {
+    let out = rcsc(&["check", "plans/submarine", "plans/figure13/figure13.rcs"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+}
+
+#[test]
+fn errors_exit_1_with_json_lines_on_stdout() {
+    let dir = scratch("json", &[("a.rcs", "controller A {\n    command GO\n    plan GO {\n        *0 when new_command && nope -> Done\n    }\n}\n")]);
+    let out = rcsc(&["check", dir.to_str().unwrap(), "--message-format", "json"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = text(&out.stdout);
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 1, "{stdout}");
+    let v: serde_json::Value = serde_json::from_str(lines[0]).expect("one JSON object per line");
+    assert_eq!(v["code"], "unknown_name");
+    assert_eq!(v["severity"], "error");
+    assert_eq!(v["line"], 4);
+    assert_eq!(v["column"], 32);
+    assert_eq!(v["end_column"], 36);
+    assert!(v["file"].as_str().unwrap().ends_with("a.rcs"));
+    assert_eq!(v["labels"][0]["primary"], true);
+    assert!(v["notes"].is_array());
+}
+
+#[test]
+fn human_output_has_a_snippet_and_a_summary_on_stderr() {
+    let dir = scratch("human", &[("a.rcs", UNUSED_VAR)]);
+    let out = rcsc(&["check", dir.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "a warning is not a failure");
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("warning[unused]: var `spare` of `A` is never used"),
+        "{err}"
+    );
+    assert!(err.contains("a.rcs:3:9"), "{err}");
+    assert!(err.contains("3 |     var spare: u8 = 0"), "{err}");
+    assert!(err.contains("warning: 1 warning emitted"), "{err}");
+    assert!(
+        !err.contains('\u{1b}'),
+        "no colour when NO_COLOR is set: {err:?}"
+    );
+    assert!(out.stdout.is_empty());
+}
+
+#[test]
+fn color_always_colours_human_output() {
+    let dir = scratch("color", &[("a.rcs", UNUSED_VAR)]);
+    let out = rcsc(&["check", dir.to_str().unwrap(), "--color", "always"]);
+    assert!(
+        text(&out.stderr).contains('\u{1b}'),
+        "ANSI escapes expected"
+    );
+}
+
+#[test]
+fn short_format_is_one_line_per_diagnostic() {
+    let dir = scratch("short", &[("a.rcs", UNUSED_VAR)]);
+    let out = rcsc(&["check", dir.to_str().unwrap(), "--message-format", "short"]);
+    let err = text(&out.stderr);
+    let first = err.lines().next().unwrap();
+    assert!(
+        first.ends_with("a.rcs:3:9: warning[unused]: var `spare` of `A` is never used"),
+        "{err}"
+    );
+}
+
+#[test]
+fn lint_flags_change_levels() {
+    let dir = scratch("flags", &[("a.rcs", UNUSED_VAR)]);
+    let d = dir.to_str().unwrap();
+    let denied = rcsc(&["check", d, "-D", "unused", "--message-format", "short"]);
+    assert_eq!(denied.status.code(), Some(1));
+    assert!(text(&denied.stderr).contains("error[unused]"));
+    let allowed = rcsc(&["check", d, "-A", "unused"]);
+    assert_eq!(allowed.status.code(), Some(0));
+    assert!(allowed.stderr.is_empty(), "{}", text(&allowed.stderr));
+    let quiet = rcsc(&["check", d, "-q"]);
+    assert_eq!(quiet.status.code(), Some(0));
+    assert!(
+        quiet.stderr.is_empty(),
+        "--quiet hides warnings: {}",
+        text(&quiet.stderr)
+    );
+}
+
+#[test]
+fn attributes_override_command_line_levels() {
+    let dir = scratch(
+        "attr",
+        &[("a.rcs", &format!("#[allow(unused)]\n{UNUSED_VAR}"))],
+    );
+    let out = rcsc(&["check", dir.to_str().unwrap(), "-D", "unused"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+}
+
+#[test]
+fn manifest_lints_apply_and_flags_override_them() {
+    let dir = scratch(
+        "manifest",
+        &[
+            ("a.rcs", UNUSED_VAR),
+            ("rcs.yaml", "lints: { unused: deny }\n"),
+        ],
+    );
+    let d = dir.to_str().unwrap();
+    assert_eq!(rcsc(&["check", d]).status.code(), Some(1));
+    assert_eq!(rcsc(&["check", d, "-W", "unused"]).status.code(), Some(0));
+}
+
+#[test]
+fn missing_paths_exit_2_naming_the_path() {
+    let out = rcsc(&["check", "no/such/plans"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = text(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("no/such/plans"), "{err}");
+}
+
+#[test]
+fn non_plan_files_exit_2() {
+    let out = rcsc(&["check", "Cargo.toml"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("Cargo.toml"));
+}
+
+#[test]
+fn unknown_lints_on_the_command_line_are_usage_errors() {
+    let out = rcsc(&["check", "plans/figure13", "-D", "no_such_lint"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("no_such_lint"));
+}
+
+#[test]
+fn non_utf8_files_are_a_diagnostic_naming_the_byte() {
+    let dir = scratch("utf8", &[]);
+    std::fs::write(dir.join("bad.rcs"), b"controller A { command GO \xff\xfe }").unwrap();
+    let out = rcsc(&["check", dir.to_str().unwrap(), "--message-format", "json"]);
+    assert_eq!(out.status.code(), Some(1));
+    let v: serde_json::Value =
+        serde_json::from_str(text(&out.stdout).lines().next().unwrap()).unwrap();
+    assert_eq!(v["code"], "syntax");
+    assert!(v["message"].as_str().unwrap().contains("offset 26"), "{v}");
+}
+
+#[test]
+fn default_path_is_the_current_folder() {
+    let out = Command::new(env!("CARGO_BIN_EXE_rcsc"))
+        .arg("check")
+        .current_dir(Path::new("plans/figure13"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+}
+
+#[test]
+fn help_lists_examples() {
+    let out = rcsc(&["check", "--help"]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(text(&out.stdout).contains("rcsc check plans/submarine"));
+}

@@ -24,6 +24,7 @@ pub mod load;
 mod lower;
 pub mod manifest;
 pub mod parser;
+pub mod pretty;
 pub mod render;
 pub mod source;
 

@@ -102,16 +102,22 @@ pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>>
                 None => Span::new(id, 0, 0),
             };
             let (message, label) = describe_yaml_error(&first_line(&e.to_string()));
-            return Err(vec![Diagnostic::error(
+            let d = Diagnostic::error(
                 Code::Manifest,
                 format!("invalid `rcs.yaml`: {message}"),
                 span,
                 label,
-            )
-            .with_help(
-                "known keys: system, plans, limits {max_rules_per_plan, max_subordinates}, \
-                 lints {LINT: allow|warn|deny}, schedule [{cpu, period, order}]",
-            )]);
+            );
+            // The list of keys helps with a misplaced key, not with broken YAML.
+            let d = if label == "unknown key" || label == "here" && message.contains("field") {
+                d.with_help(
+                    "known keys: system, plans, limits {max_rules_per_plan, max_subordinates}, \
+                     lints {LINT: allow|warn|deny}, schedule [{cpu, period, order}]",
+                )
+            } else {
+                d
+            };
+            return Err(vec![d]);
         }
     };
 

@@ -463,6 +463,11 @@ impl Builder {
         let (outer, mut rest) = self.split_outer(p);
         let def = rest.pop()?;
         let span = self.span(&def);
+        match def.as_rule() {
+            Rule::enum_def => self.no_attributes(&outer, "an enum"),
+            Rule::buffer_def => self.no_attributes(&outer, "a buffer"),
+            _ => {}
+        }
         let mut inner = def.clone().into_inner();
         Some(match def.as_rule() {
             Rule::enum_def => {

@@ -135,7 +135,7 @@ fn hierarchy_bench(c: &mut Criterion) {
         let mut n = 0u32;
         g.bench_function(label, |b| {
             b.iter(|| {
-                if n % 20 == 0 {
+                if n.is_multiple_of(20) {
                     op.command(common::GO);
                 }
                 n = n.wrapping_add(1);

@@ -243,7 +243,7 @@ pub fn parse_duration(text: &str) -> Option<u64> {
     };
     let v: f64 = num.parse().ok()?;
     let ns = v * scale;
-    (ns.is_finite() && ns >= 1.0 && ns < 1e18).then_some(ns.round() as u64)
+    (1.0..1e18).contains(&ns).then_some(ns.round() as u64)
 }
 
 fn is_identifier(s: &str) -> bool {

@@ -1759,13 +1759,9 @@ fn unify(a: &Ty, b: &Ty) -> Option<Ty> {
     use Ty::*;
     Some(match (a, b) {
         (Err, _) | (_, Err) => Err,
-        (Known(x), Known(y)) => {
-            if x == y {
-                Known(x.clone())
-            } else {
-                return None;
-            }
-        }
+        // Two typed operands meet only when their types are equal (the last
+        // arm says `None` otherwise).
+        (Known(x), Known(y)) if x == y => Known(x.clone()),
         (IntLit, Known(t @ (Type::Int(_) | Type::Float(_))))
         | (Known(t @ (Type::Int(_) | Type::Float(_))), IntLit) => Known(t.clone()),
         (FloatLit, Known(t @ Type::Float(_))) | (Known(t @ Type::Float(_)), FloatLit) => {

@@ -8,9 +8,12 @@
 //!    ──table─▶ tables/<CTRL>.md
 //! ```
 
+pub mod config;
 pub mod dot;
 pub mod table;
 pub mod writer;
+
+pub use config::Config;
 
 use rcs_dsl::ir::Ir;
 

@@ -253,7 +253,7 @@ fn rule_words(rule: Rule) -> Option<&'static str> {
         Rule::attribute => "an attribute `#[…]`",
         Rule::ident => "a name",
         Rule::int_lit => "an integer",
-        Rule::float_lit => "a number",
+        Rule::number => "a number",
         Rule::string_lit => "a title string",
         Rule::type_expr | Rule::array_type => "a type",
         Rule::variant => "a variant name",
@@ -275,7 +275,7 @@ fn rule_words(rule: Rule) -> Option<&'static str> {
             "an expression"
         }
         Rule::call_args => "`(`",
-        Rule::op_or | Rule::op_and | Rule::op_cmp | Rule::op_add | Rule::op_mul => "an operator",
+        Rule::infix => "an operator",
         Rule::op_unary => "an expression",
         Rule::field_access => "`.`",
         Rule::index => "`[`",
@@ -987,14 +987,16 @@ impl Builder {
         let span = self.span(&p);
         let mut height = 1;
         let kind = match p.as_rule() {
-            Rule::float_lit => match p.as_str().replace('_', "").parse::<f64>() {
-                Ok(v) if v.is_finite() => ExprKind::Float(v),
-                _ => {
-                    self.error(span, "float literal is out of range", "not a finite f64");
-                    ExprKind::Float(0.0)
+            Rule::number if p.as_str().contains(['.', 'e', 'E']) => {
+                match p.as_str().replace('_', "").parse::<f64>() {
+                    Ok(v) if v.is_finite() => ExprKind::Float(v),
+                    _ => {
+                        self.error(span, "float literal is out of range", "not a finite f64");
+                        ExprKind::Float(0.0)
+                    }
                 }
-            },
-            Rule::int_lit => match p.as_str().replace('_', "").parse::<u128>() {
+            }
+            Rule::number => match p.as_str().replace('_', "").parse::<u128>() {
                 Ok(v) if v <= u64::MAX as u128 => ExprKind::Int(v),
                 _ => {
                     self.error(

@@ -201,3 +201,28 @@ pub use handshake::{
 pub use operator::{read_status, Operator};
 pub use plan::{Bookkeeping, NewCommand, SampleStats, Target, Tick, VerbStats};
 pub use trace::{read_trace, TraceRecord, TraceSink};
+
+/// Include the Rust code `rcsc` generated for a system from a build script.
+///
+/// `include_plans!("submarine")` expands to
+/// `include!(concat!(env!("OUT_DIR"), "/rcs/rust/submarine.rs"))`: the file
+/// `rcs_codegen::Config::compile` writes for the plan set whose system (the
+/// manifest's `system:`, or the folder's name) is `submarine`. Use it at
+/// module level.
+///
+/// ```ignore
+/// // build.rs (with `rcs-codegen` in [build-dependencies])
+/// fn main() -> Result<(), Box<dyn std::error::Error>> {
+///     rcs_codegen::Config::new().compile("plans/submarine")?;
+///     Ok(())
+/// }
+///
+/// // src/lib.rs
+/// rcs_runtime::include_plans!("submarine");
+/// ```
+#[macro_export]
+macro_rules! include_plans {
+    ($name:literal) => {
+        include!(concat!(env!("OUT_DIR"), "/rcs/rust/", $name, ".rs"));
+    };
+}

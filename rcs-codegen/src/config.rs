@@ -23,7 +23,9 @@
 //!   summary line, and `Err` (nothing is written).
 
 use crate::writer::{self, WriteError, WriteReport};
-use rcs_dsl::lint::{Level, Lint};
+/// The lint names and levels of [`Config::lint`], re-exported so that a
+/// build script needs no direct dependency on `rcs-dsl`.
+pub use rcs_dsl::lint::{Level, Lint};
 use rcs_dsl::render::{self, Format};
 use rcs_dsl::{LoadError, Severity};
 use std::io::Write;
@@ -38,8 +40,9 @@ pub struct Config {
     graphs: bool,
 }
 
-/// Why [`Config::compile`] failed.
-#[derive(Debug, thiserror::Error)]
+/// Why [`Config::compile`] failed. Its `Debug` is its message, so that a
+/// `build.rs` whose `main` returns the error prints one readable line.
+#[derive(thiserror::Error)]
 pub enum CompileError {
     /// A variable cargo sets for build scripts is missing and no explicit
     /// setting replaces it.
@@ -65,6 +68,12 @@ pub enum CompileError {
     /// Printing to cargo failed.
     #[error("writing build-script output: {0}")]
     Io(#[from] std::io::Error),
+}
+
+impl std::fmt::Debug for CompileError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        std::fmt::Display::fmt(self, f)
+    }
 }
 
 impl Default for Config {

@@ -4,12 +4,15 @@
 //! touches the file system.
 //!
 //! ```text
-//! Ir ──dot──▶ graphs/<CTRL>/<VERB>.dot, graphs/hierarchy.dot
+//! Ir ──rust──▶ rust/<system>.rs
+//!    ──dot───▶ graphs/<CTRL>/<VERB>.dot, graphs/hierarchy.dot
 //!    ──table─▶ tables/<CTRL>.md
 //! ```
 
 pub mod config;
 pub mod dot;
+pub mod ident;
+pub mod rust;
 pub mod table;
 pub mod writer;
 
@@ -29,7 +32,10 @@ pub struct OutputFile {
 
 /// Every output of one plan set, in a fixed order.
 pub fn generate(ir: &Ir) -> Vec<OutputFile> {
-    let mut files = Vec::new();
+    let mut files = vec![OutputFile {
+        path: format!("rust/{}.rs", ir.system),
+        contents: rust::system_module(ir),
+    }];
     for ctrl in &ir.controllers {
         for cmd in &ctrl.commands {
             let Some(pid) = cmd.plan else { continue };

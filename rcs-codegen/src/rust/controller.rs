@@ -1,0 +1,743 @@
+//! One controller → one Rust module: its command enum, status and error
+//! enums, a state enum per plan, the `Hooks` trait, the `Data` it works on
+//! and `Controller`, whose `cycle` is SEMANTICS.md's six steps with the
+//! rows compiled to a dispatch on the state.
+
+use super::expr::{rust_type, zero, Code, Gen};
+use super::names::Names;
+use super::Comments;
+use proc_macro2::TokenStream;
+use quote::{format_ident, quote};
+use rcs_dsl::ir::*;
+use rcs_dsl::pretty::Printer;
+
+fn docs(lines: &[String]) -> TokenStream {
+    let lines = lines.iter().map(|l| format!(" {l}"));
+    quote!(#(#[doc = #lines])*)
+}
+
+/// Whether the leftmost conjunct of a condition is `new_command`: such a
+/// row can only match in S0, so other states' arms leave it out without
+/// skipping any hook call it would have made.
+fn starts_with_new_command(e: &Expr) -> bool {
+    match &e.kind {
+        ExprKind::NewCommand => true,
+        ExprKind::Binary(rcs_dsl::ast::BinOp::And, l, _) => starts_with_new_command(l),
+        _ => false,
+    }
+}
+
+/// Whether `Default` can be derived for a type (std has it for arrays up to 32).
+pub(crate) fn derivable_default(t: &Type) -> bool {
+    match t {
+        Type::Array(elem, n) => *n <= 32 && derivable_default(elem),
+        _ => true,
+    }
+}
+
+pub(crate) fn is_zero(e: &Expr) -> bool {
+    match &e.kind {
+        ExprKind::Int(0) | ExprKind::Bool(false) => true,
+        ExprKind::Float(v) => *v == 0.0 && v.is_sign_positive(),
+        ExprKind::Variant(_, 0) => true,
+        _ => false,
+    }
+}
+
+pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments) -> TokenStream {
+    let c = &ir.controllers[ci];
+    let n = &names.ctrls[ci];
+    let name = &c.name;
+    let module = &n.module;
+    let mod_docs = docs(&c.docs);
+    let title = c
+        .title
+        .as_ref()
+        .map(|t| format!(" `{name}`: {t}."))
+        .unwrap_or_else(|| format!(" Controller `{name}`."));
+
+    // ---- commands
+    let verb_count = c.commands.len();
+    let command_enum = if c.commands.is_empty() {
+        quote! {
+            /// `#name` accepts no commands.
+            #[derive(Clone, Copy, Debug, Default, PartialEq)]
+            pub struct Command;
+            impl rt::Command for Command {
+                fn verb(&self) -> rt::VerbId { 0 }
+            }
+        }
+    } else {
+        // `#[default]` only works on a unit variant; otherwise the first
+        // verb with zero parameters is the default, written out.
+        let unit_first = c.commands[0].params.is_empty();
+        let variants = c.commands.iter().enumerate().map(|(i, k)| {
+            let v = &n.commands[i];
+            let d = docs(&k.docs);
+            let default = if i == 0 && unit_first {
+                quote!(#[default])
+            } else {
+                quote!()
+            };
+            if k.params.is_empty() {
+                quote!(#d #default #v)
+            } else {
+                let ps = &n.params[i];
+                let tys = k.params.iter().map(|p| rust_type(ir, names, &p.ty));
+                quote!(#d #default #v { #(#ps: #tys),* })
+            }
+        });
+        let arms = c.commands.iter().enumerate().map(|(i, k)| {
+            let v = &n.commands[i];
+            let i = i as u16;
+            if k.params.is_empty() {
+                quote!(Self::#v => #i)
+            } else {
+                quote!(Self::#v { .. } => #i)
+            }
+        });
+        let cmd_doc = format!(" The command verbs of `{name}`, with their parameters.");
+        let (derive_default, default_impl) = if unit_first {
+            (quote!(Default,), quote!())
+        } else {
+            let v = &n.commands[0];
+            let ps = &n.params[0];
+            let zeros = c.commands[0].params.iter().map(|p| zero(ir, names, &p.ty));
+            (
+                quote!(),
+                quote! {
+                    impl Default for Command {
+                        fn default() -> Self { Self::#v { #(#ps: #zeros),* } }
+                    }
+                },
+            )
+        };
+        quote! {
+            #[doc = #cmd_doc]
+            #[derive(Clone, Copy, Debug, #derive_default PartialEq)]
+            pub enum Command { #(#variants),* }
+            #default_impl
+            impl rt::Command for Command {
+                fn verb(&self) -> rt::VerbId {
+                    match self { #(#arms),* }
+                }
+            }
+        }
+    };
+
+    // ---- statuses and errors
+    let status_consts = c.statuses.iter().enumerate().map(|(i, s)| {
+        let id = &n.status_consts[i];
+        let value = match i {
+            0 => quote!(rt::Status::NOT_READY),
+            1 => quote!(rt::Status::EXECUTING),
+            2 => quote!(rt::Status::DONE),
+            3 => quote!(rt::Status::ERROR),
+            _ => {
+                let k = (i - 4) as u16;
+                quote!(rt::Status::custom(#k))
+            }
+        };
+        let d = docs(&s.docs);
+        quote!(#d pub const #id: rt::Status = #value;)
+    });
+    let status_variants: Vec<_> = n.status_variants.iter().collect();
+    let status_consts_ids: Vec<_> = n.status_consts.iter().collect();
+    let status_names: Vec<&str> = c.statuses.iter().map(|s| s.name.as_str()).collect();
+    let error_consts = c.errors.iter().enumerate().map(|(i, e)| {
+        let id = &n.error_consts[i];
+        let k = i as u16;
+        let d = docs(&e.docs);
+        quote!(#d pub const #id: rt::ErrorCode = rt::ErrorCode::custom(#k);)
+    });
+    let error_variants: Vec<_> = n.error_variants.iter().collect();
+    let error_consts_ids: Vec<_> = n.error_consts.iter().collect();
+    let error_names: Vec<&str> = c.errors.iter().map(|e| e.name.as_str()).collect();
+
+    // ---- plan state enums
+    let state_enums = c.plans.iter().enumerate().map(|(pi, p)| {
+        let pn = &n.plans[pi];
+        let ty = &pn.state_ty;
+        let vs = &pn.states;
+        let ids: Vec<u16> = (0..p.states.len() as u16).collect();
+        let doc = format!(" The states of plan `{}`.", c.commands[p.verb.index()].name);
+        let state_names: Vec<&str> = p.states.iter().map(|s| s.name.as_str()).collect();
+        quote! {
+            #[doc = #doc]
+            #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+            pub enum #ty { #(#vs),* }
+            impl #ty {
+                /// The state with this runtime id.
+                pub const fn from_raw(raw: rt::StateId) -> Option<Self> {
+                    match raw { #(#ids => Some(Self::#vs),)* _ => None }
+                }
+                /// The runtime id of this state.
+                pub const fn raw(self) -> rt::StateId {
+                    match self { #(Self::#vs => #ids),* }
+                }
+                /// The state's name in the plan.
+                pub const fn name(self) -> &'static str {
+                    match self { #(Self::#vs => #state_names),* }
+                }
+            }
+        }
+    });
+
+    // ---- hooks
+    let hook_fns = c.hooks.iter().enumerate().map(|(hi, h)| {
+        let id = &n.hooks[hi];
+        let ps = &n.hook_params[hi];
+        let tys = h.params.iter().map(|p| rust_type(ir, names, &p.ty));
+        let d = docs(&h.docs);
+        if h.ret == Type::Unit {
+            quote!(#d fn #id(&mut self, data: &Data #(, #ps: #tys)*);)
+        } else {
+            let ret = rust_type(ir, names, &h.ret);
+            quote!(#d fn #id(&mut self, data: &Data #(, #ps: #tys)*) -> #ret;)
+        }
+    });
+    let unit_hooks = if c.hooks.is_empty() {
+        quote!(impl Hooks for () {})
+    } else {
+        quote!()
+    };
+    let hooks_doc = format!(
+        " The hand-written sensory-processing and world-model functions of `{name}`. Each sees the controller's current data read-only."
+    );
+
+    // ---- data
+    let read_fields: Vec<_> = c
+        .reads
+        .iter()
+        .map(|b| n.buffers[b.index()].clone().expect("own buffer"))
+        .collect();
+    let read_tys: Vec<_> = c
+        .reads
+        .iter()
+        .map(|b| rust_type(ir, names, &Type::Buffer(ir.buffers[b.index()].ty)))
+        .collect();
+    let write_fields: Vec<_> = c
+        .writes
+        .iter()
+        .map(|b| n.buffers[b.index()].clone().expect("own buffer"))
+        .collect();
+    let write_tys: Vec<_> = c
+        .writes
+        .iter()
+        .map(|b| rust_type(ir, names, &Type::Buffer(ir.buffers[b.index()].ty)))
+        .collect();
+    let sub_fields = &n.subs;
+    let var_fields = &n.vars;
+    let var_tys: Vec<_> = c.vars.iter().map(|v| rust_type(ir, names, &v.ty)).collect();
+    let var_docs: Vec<_> = c.vars.iter().map(|v| docs(&v.docs)).collect();
+    let const_gen = Gen {
+        ir,
+        names,
+        ctrl: c,
+        ci,
+    };
+    let var_defaults_derivable = c
+        .vars
+        .iter()
+        .all(|v| derivable_default(&v.ty) && v.init.as_ref().is_none_or(is_zero));
+    let (vars_derive, vars_default) = if var_defaults_derivable {
+        (quote!(Default,), quote!())
+    } else {
+        let inits = c.vars.iter().map(|v| match &v.init {
+            Some(e) => const_gen.expr(e).ts,
+            None => zero(ir, names, &v.ty),
+        });
+        (
+            quote!(),
+            quote! {
+                impl Default for Vars {
+                    fn default() -> Self {
+                        Self { #(#var_fields: #inits),* }
+                    }
+                }
+            },
+        )
+    };
+
+    // ---- plans
+    let plan_fns: Vec<TokenStream> = c
+        .plans
+        .iter()
+        .enumerate()
+        .map(|(pi, p)| plan_fn(ir, names, ci, pi, p, comments))
+        .collect();
+    let decide_arms = c.commands.iter().enumerate().filter_map(|(i, k)| {
+        let pid = k.plan?;
+        let func = &n.plans[pid.index()].func;
+        let v = &n.commands[i];
+        let used = used_params(&c.plans[pid.index()]);
+        let binds: Vec<TokenStream> = k
+            .params
+            .iter()
+            .enumerate()
+            .filter(|(pi, _)| used.contains(&ParamId(*pi as u32)))
+            .map(|(pi, _)| {
+                let field = &n.params[i][pi];
+                let local = format_ident!("cmd_{}", field.to_string().trim_start_matches("r#"));
+                quote!(#field: #local)
+            })
+            .collect();
+        let locals: Vec<TokenStream> = k
+            .params
+            .iter()
+            .enumerate()
+            .filter(|(pi, _)| used.contains(&ParamId(*pi as u32)))
+            .map(|(pi, _)| {
+                let local = format_ident!(
+                    "cmd_{}",
+                    n.params[i][pi].to_string().trim_start_matches("r#")
+                );
+                quote!(#local)
+            })
+            .collect();
+        Some(if k.params.is_empty() {
+            quote!(Command::#v => self.#func())
+        } else {
+            quote!(Command::#v { #(#binds,)* .. } => self.#func(#(#locals),*))
+        })
+    });
+    let decide = if c.commands.is_empty() {
+        quote!(
+            fn decide(&mut self) {}
+        )
+    } else {
+        quote! {
+            /// Step 4: the plan of the active command picks at most one row.
+            fn decide(&mut self) {
+                match self.data.command { #(#decide_arms,)* }
+            }
+        }
+    };
+
+    // ---- Global Memory handles
+    let read_handles: Vec<_> = read_fields
+        .iter()
+        .map(|f| format_ident!("in_{}", f.to_string().trim_start_matches("r#")))
+        .collect();
+    let write_handles: Vec<_> = write_fields
+        .iter()
+        .map(|f| format_ident!("out_{}", f.to_string().trim_start_matches("r#")))
+        .collect();
+    let sub_handles: Vec<_> = sub_fields
+        .iter()
+        .map(|f| format_ident!("sub_{}", f.to_string().trim_start_matches("r#")))
+        .collect();
+    let read_names: Vec<&str> = c
+        .reads
+        .iter()
+        .map(|b| ir.buffers[b.index()].name.as_str())
+        .collect();
+    let write_names: Vec<&str> = c
+        .writes
+        .iter()
+        .map(|b| ir.buffers[b.index()].name.as_str())
+        .collect();
+    let sub_names: Vec<&str> = c
+        .subordinates
+        .iter()
+        .map(|s| ir.controllers[s.index()].name.as_str())
+        .collect();
+    let sub_modules: Vec<_> = c
+        .subordinates
+        .iter()
+        .map(|s| &names.ctrls[s.index()].module)
+        .collect();
+    let verb_count_lit = proc_macro2::Literal::usize_unsuffixed(verb_count);
+
+    quote! {
+        #mod_docs
+        #[doc = #title]
+        pub mod #module {
+            use ::rcs_runtime as rt;
+
+            /// The controller's name in Global Memory and in traces.
+            pub const NAME: &str = #name;
+
+            #command_enum
+
+            /// `#name`'s statuses as runtime values: the built-ins, then its own.
+            pub mod status {
+                use ::rcs_runtime as rt;
+                #(#status_consts)*
+            }
+
+            /// `#name`'s error codes as runtime values.
+            pub mod error {
+                use ::rcs_runtime as rt;
+                /// No error.
+                pub const NONE: rt::ErrorCode = rt::ErrorCode::NONE;
+                /// A command whose verb has no plan (only from an outside writer).
+                pub const UNKNOWN_COMMAND: rt::ErrorCode = rt::ErrorCode::UNKNOWN_COMMAND;
+                #(#error_consts)*
+            }
+
+            /// A status of this controller.
+            #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+            pub enum Status { #(#status_variants),* }
+            impl Status {
+                /// The typed status of a runtime value, if it is one of this controller's.
+                pub const fn from_raw(raw: rt::Status) -> Option<Self> {
+                    #(if raw.0 == status::#status_consts_ids.0 { return Some(Self::#status_variants); })*
+                    None
+                }
+                /// The runtime value.
+                pub const fn raw(self) -> rt::Status {
+                    match self { #(Self::#status_variants => status::#status_consts_ids),* }
+                }
+                /// The name as written in the plans.
+                pub const fn name(self) -> &'static str {
+                    match self { #(Self::#status_variants => #status_names),* }
+                }
+            }
+
+            /// An error code this controller reports.
+            #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+            pub enum Error { UnknownCommand, #(#error_variants),* }
+            impl Error {
+                /// The typed error of a runtime code (`None` for no error).
+                pub const fn from_raw(raw: rt::ErrorCode) -> Option<Self> {
+                    if raw.0 == error::UNKNOWN_COMMAND.0 { return Some(Self::UnknownCommand); }
+                    #(if raw.0 == error::#error_consts_ids.0 { return Some(Self::#error_variants); })*
+                    None
+                }
+                /// The runtime code.
+                pub const fn raw(self) -> rt::ErrorCode {
+                    match self {
+                        Self::UnknownCommand => error::UNKNOWN_COMMAND,
+                        #(Self::#error_variants => error::#error_consts_ids),*
+                    }
+                }
+                /// The name as written in the plans.
+                pub const fn name(self) -> &'static str {
+                    match self {
+                        Self::UnknownCommand => "UNKNOWN_COMMAND",
+                        #(Self::#error_variants => #error_names),*
+                    }
+                }
+            }
+
+            #(#state_enums)*
+
+            #[doc = #hooks_doc]
+            pub trait Hooks: Send { #(#hook_fns)* }
+            #unit_hooks
+
+            /// The Global Memory buffers this controller reads, as copied in this cycle.
+            #[derive(Clone, Copy, Debug, Default, PartialEq)]
+            pub struct Reads { #(pub #read_fields: #read_tys),* }
+
+            /// The Global Memory buffers this controller alone writes.
+            #[derive(Clone, Copy, Debug, Default, PartialEq)]
+            pub struct Writes { #(pub #write_fields: #write_tys),* }
+
+            /// The subordinates' statuses, seen through the handshake.
+            #[derive(Clone, Copy, Debug, Default, PartialEq)]
+            pub struct Subs { #(pub #sub_fields: rt::SubordinateView),* }
+
+            /// The controller's own world-model variables; they persist across cycles.
+            #[derive(Clone, Copy, Debug, #vars_derive PartialEq)]
+            pub struct Vars { #(#var_docs pub #var_fields: #var_tys),* }
+            #vars_default
+
+            /// Everything a cycle works on. Hooks see it read-only.
+            #[derive(Clone, Copy, Debug, Default, PartialEq)]
+            pub struct Data {
+                /// The command being executed.
+                pub command: Command,
+                pub reads: Reads,
+                pub subs: Subs,
+                pub vars: Vars,
+                pub writes: Writes,
+            }
+
+            /// The controller: its data, its plans' bookkeeping and its Global Memory handles.
+            #[derive(Debug)]
+            pub struct Controller<H: Hooks> {
+                hooks: H,
+                data: Data,
+                bk: rt::Bookkeeping,
+                command_in: rt::Reader<rt::CommandBuffer<Command>>,
+                status_out: rt::Writer<rt::StatusBuffer>,
+                #(#read_handles: rt::Reader<#read_tys>,)*
+                #(#write_handles: rt::Writer<#write_tys>,)*
+                #(#sub_handles: rt::Subordinate<super::#sub_modules::Command>,)*
+            }
+
+            impl<H: Hooks> Controller<H> {
+                /// Connect to Global Memory: this controller's command and
+                /// status buffers, its buffers, and its subordinates' command
+                /// buffers (taking their one writer).
+                pub fn new(gm: &rt::GlobalMemory, hooks: H) -> Result<Self, rt::SetupError> {
+                    gm.declare_controller::<Command>(NAME)?;
+                    #(gm.declare::<#read_tys>(#read_names)?;)*
+                    #(gm.declare::<#write_tys>(#write_names)?;)*
+                    Ok(Self {
+                        hooks,
+                        data: Data::default(),
+                        bk: rt::Bookkeeping::new(#verb_count_lit),
+                        command_in: gm.command_reader(NAME)?,
+                        status_out: gm.status_writer(NAME)?,
+                        #(#read_handles: gm.reader(#read_names)?,)*
+                        #(#write_handles: gm.writer(#write_names)?,)*
+                        #(#sub_handles: rt::Subordinate::connect(gm, #sub_names)?,)*
+                    })
+                }
+
+                /// The data of the last cycle.
+                pub fn data(&self) -> &Data { &self.data }
+                /// The hooks.
+                pub fn hooks(&self) -> &H { &self.hooks }
+                /// The hooks, to adjust hand-written state between cycles.
+                pub fn hooks_mut(&mut self) -> &mut H { &mut self.hooks }
+                /// The plan bookkeeping: verb, state, status, counters, fired row.
+                pub fn bookkeeping(&self) -> &rt::Bookkeeping { &self.bk }
+                /// The current status, typed.
+                pub fn status(&self) -> Option<Status> { Status::from_raw(self.bk.status()) }
+
+                #decide
+
+                #(#plan_fns)*
+            }
+
+            impl<H: Hooks> rt::Controller for Controller<H> {
+                fn name(&self) -> &str { NAME }
+
+                fn cycle(&mut self, ctx: &rt::CycleContext) {
+                    // 1. Read: copy in the command, every read buffer and every subordinate's status once.
+                    let command = self.command_in.read().value;
+                    #(self.data.reads.#read_fields = self.#read_handles.read().value;)*
+                    // 2. The handshake view of each subordinate.
+                    #(self.data.subs.#sub_fields = self.#sub_handles.read();)*
+                    // 3. A new serial starts the plan of its verb in S0.
+                    self.bk.begin_cycle(ctx.tick(), &command, true);
+                    if self.bk.new_command() {
+                        self.data.command = command.command;
+                    }
+                    // 4. Decide.
+                    if self.bk.is_active() {
+                        self.decide();
+                    }
+                    // 5. Write: status, written buffers, commands sent this cycle.
+                    self.status_out.write(self.bk.status_buffer(), ctx.cycle);
+                    #(self.#write_handles.write(self.data.writes.#write_fields, ctx.cycle);)*
+                    #(self.#sub_handles.flush(ctx.cycle);)*
+                    // 6. Account.
+                    self.bk.end_cycle();
+                }
+
+                fn bookkeeping(&self) -> Option<&rt::Bookkeeping> { Some(&self.bk) }
+            }
+        }
+    }
+}
+
+/// The parameters of the plan's command that its rows read.
+fn used_params(p: &Plan) -> Vec<ParamId> {
+    let mut used = Vec::new();
+    for r in &p.rows {
+        r.visit_exprs(&mut |e| {
+            if let ExprKind::CmdParam(_, pid) = e.kind {
+                if !used.contains(&pid) {
+                    used.push(pid);
+                }
+            }
+        });
+    }
+    used
+}
+
+/// One plan as a method: bind the used parameters, dispatch on the state,
+/// then try that state's rows merged with the don't-care rows in
+/// precedence order; `otherwise` closes every chain.
+fn plan_fn(
+    ir: &Ir,
+    names: &Names,
+    ci: usize,
+    pi: usize,
+    p: &Plan,
+    comments: &mut Comments,
+) -> TokenStream {
+    let c = &ir.controllers[ci];
+    let n = &names.ctrls[ci];
+    let pn = &n.plans[pi];
+    let func = &pn.func;
+    let cmd = &c.commands[p.verb.index()];
+    let used = used_params(p);
+    let args: Vec<TokenStream> = cmd
+        .params
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| used.contains(&ParamId(*i as u32)))
+        .map(|(i, param)| {
+            let local = format_ident!(
+                "cmd_{}",
+                n.params[p.verb.index()][i]
+                    .to_string()
+                    .trim_start_matches("r#")
+            );
+            let ty = rust_type(ir, names, &param.ty);
+            quote!(#local: #ty)
+        })
+        .collect();
+    let gen = Gen {
+        ir,
+        names,
+        ctrl: c,
+        ci,
+    };
+    let printer = Printer::new(ir, c, Some(p));
+    let state_ty = &pn.state_ty;
+    let file = ir.files[p.header.file.0 as usize]
+        .rsplit('/')
+        .next()
+        .unwrap_or("")
+        .to_string();
+
+    let row_code = |r: &Row, comments: &mut Comments| -> (Option<Code>, TokenStream) {
+        let text = format!(
+            "{}: {} when {} -> {}   [{file}:{}]",
+            printer.label(r),
+            printer.from(r),
+            printer.condition(r),
+            printer.target(r),
+            r.line
+        );
+        let marker = comments.marker(text);
+        let jobs: Vec<TokenStream> = r.jobs.iter().map(|j| gen.job(j)).collect();
+        let pos = r.position as u16;
+        let target = match r.to {
+            Target::State(s) => {
+                let v = &pn.states[s.index()];
+                quote!(rt::Target::State(#state_ty::#v.raw()))
+            }
+            Target::Same => quote!(rt::Target::Same),
+            Target::Done => quote!(rt::Target::Done),
+            Target::Error(None) => quote!(rt::Target::Error(error::NONE)),
+            Target::Error(Some(e)) => {
+                let id = &n.error_consts[e.index()];
+                quote!(rt::Target::Error(error::#id))
+            }
+        };
+        let body = quote! {
+            #marker
+            #(#jobs)*
+            self.bk.fire(#pos, #target);
+        };
+        let cond = match &r.cond {
+            Condition::When(e) => Some(gen.expr(e)),
+            Condition::Otherwise => None,
+        };
+        (cond, body)
+    };
+
+    // The rows of one arm as an if / else-if chain, `otherwise` last.
+    let chain = |rows: &[&Row], comments: &mut Comments| -> TokenStream {
+        let mut parts: Vec<(Option<Code>, TokenStream)> =
+            rows.iter().map(|r| row_code(r, comments)).collect();
+        let otherwise = p.otherwise().map(|r| row_code(r, comments).1);
+        // Build from the end: else-branch first.
+        let mut tail: Option<TokenStream> = otherwise;
+        while let Some((cond, body)) = parts.pop() {
+            let cond = cond.expect("only otherwise has no condition");
+            tail = Some(if cond.has_block {
+                // A hoisted hook call cannot stand in an `if` condition.
+                let ts = &cond.ts;
+                let rest = tail.map(|t| quote!(else { #t })).unwrap_or_default();
+                quote!({ let matched = #ts; if matched { #body } #rest })
+            } else {
+                let ts = &cond.ts;
+                match tail {
+                    None => quote!(if #ts { #body }),
+                    Some(t) if t.to_string().starts_with("if ") => quote!(if #ts { #body } else #t),
+                    Some(t) => quote!(if #ts { #body } else { #t }),
+                }
+            });
+        }
+        tail.unwrap_or_default()
+    };
+
+    let ordinary: Vec<&Row> = p.rows.iter().filter(|r| !r.is_otherwise()).collect();
+    let dont_care_only: Vec<&Row> = ordinary
+        .iter()
+        .copied()
+        .filter(|r| r.is_dont_care())
+        .collect();
+    // States with rows of their own get an arm; every other state (S0 too,
+    // unless it has rows) shares the don't-care arm.
+    let mut arm_states: Vec<StateId> = Vec::new();
+    for r in &ordinary {
+        if let From::State(s) = r.from {
+            if !arm_states.contains(&s) {
+                arm_states.push(s);
+            }
+        }
+    }
+    arm_states.sort();
+    let arms: Vec<(StateId, TokenStream)> = arm_states
+        .iter()
+        .map(|s| {
+            let rows: Vec<&Row> = ordinary
+                .iter()
+                .copied()
+                .filter(|r| match r.from {
+                    From::State(x) => x == *s,
+                    From::DontCare(_) => {
+                        let entry_only =
+                            matches!(&r.cond, Condition::When(e) if starts_with_new_command(e));
+                        *s == StateId::S0 || !entry_only
+                    }
+                })
+                .collect();
+            (*s, chain(&rows, comments))
+        })
+        .collect();
+    let default_arm = chain(&dont_care_only, comments);
+    let body = if arms.is_empty() {
+        default_arm
+    } else if arms.len() == 1 && default_arm.is_empty() {
+        let (s, code) = &arms[0];
+        let v = &pn.states[s.index()];
+        quote!(if self.bk.state() == #state_ty::#v.raw() { #code })
+    } else {
+        let pats = arms.iter().map(|(s, _)| {
+            let v = &pn.states[s.index()];
+            quote!(Some(#state_ty::#v))
+        });
+        let codes = arms.iter().map(|(_, c)| c);
+        quote! {
+            match #state_ty::from_raw(self.bk.state()) {
+                #(#pats => { #codes })*
+                _ => { #default_arm }
+            }
+        }
+    };
+    let doc = format!(" Plan `{}` ({} rows).", cmd.name, p.rows.len());
+    quote! {
+        #[doc = #doc]
+        // Conditions are the plan's own, verbatim: redundant or duplicated
+        // logic in a plan is the plan's (rcsc's checks report what matters,
+        // e.g. `shadowed_row`) and must not fail the user's clippy run.
+        #[allow(
+            unused_comparisons,
+            clippy::nonminimal_bool,
+            clippy::overly_complex_bool_expr,
+            clippy::eq_op,
+            clippy::redundant_comparisons,
+            clippy::double_comparisons,
+            clippy::ifs_same_cond,
+            clippy::identity_op,
+            clippy::erasing_op,
+            clippy::absurd_extreme_comparisons,
+            clippy::manual_range_contains,
+            clippy::approx_constant
+        )]
+        fn #func(&mut self #(, #args)*) {
+            #body
+        }
+    }
+}

@@ -1,0 +1,557 @@
+//! IR expressions and jobs → Rust tokens for the inside of a controller
+//! module. Parentheses are inserted only where Rust's precedence needs them
+//! (rustc warns about the others). Integer arithmetic wraps and division by
+//! zero yields 0, so no generated operation can panic; the interpreter
+//! implements the same rules.
+
+use super::names::Names;
+use proc_macro2::TokenStream;
+use quote::{format_ident, quote};
+use rcs_dsl::ast::{AssignOp, BinOp, UnOp};
+use rcs_dsl::ir::*;
+
+/// Rust binding strengths (larger binds tighter).
+const OR: u8 = 1;
+const AND: u8 = 2;
+const CMP: u8 = 3;
+const ADD: u8 = 5;
+const MUL: u8 = 6;
+const CAST: u8 = 7;
+const UNARY: u8 = 8;
+const ATOM: u8 = 9;
+
+/// Generated code with its strength, and whether it holds a block
+/// (a hoisted nested hook call), which cannot stand in an `if` condition.
+pub(crate) struct Code {
+    pub ts: TokenStream,
+    pub prec: u8,
+    pub has_block: bool,
+}
+
+impl Code {
+    fn atom(ts: TokenStream) -> Code {
+        Code {
+            ts,
+            prec: ATOM,
+            has_block: false,
+        }
+    }
+
+    /// The tokens, parenthesised if they bind looser than `min`.
+    pub fn at(&self, min: u8) -> TokenStream {
+        let ts = &self.ts;
+        if self.prec < min {
+            quote!((#ts))
+        } else {
+            ts.clone()
+        }
+    }
+}
+
+/// Where an expression is generated.
+pub(crate) struct Gen<'a> {
+    pub ir: &'a Ir,
+    pub names: &'a Names,
+    pub ctrl: &'a Controller,
+    pub ci: usize,
+}
+
+pub(crate) fn rust_type(ir: &Ir, names: &Names, t: &Type) -> TokenStream {
+    match t {
+        Type::Bool => quote!(bool),
+        Type::Int(i) => {
+            let id = format_ident!("{}", i.name());
+            quote!(#id)
+        }
+        Type::Float(f) => {
+            let id = format_ident!("{}", f.name());
+            quote!(#id)
+        }
+        Type::Enum(e) => {
+            let id = &names.enums[e.index()].ty;
+            quote!(super::types::#id)
+        }
+        Type::Buffer(b) => {
+            let id = &names.buffers[b.index()].ty;
+            quote!(super::types::#id)
+        }
+        Type::Array(elem, n) => {
+            let elem = rust_type(ir, names, elem);
+            let n = proc_macro2::Literal::usize_unsuffixed(*n as usize);
+            quote!([#elem; #n])
+        }
+        Type::Status(_) => quote!(rt::Status),
+        Type::Unit => quote!(()),
+    }
+}
+
+/// The zero value of a type, as a constant expression.
+pub(crate) fn zero(ir: &Ir, names: &Names, t: &Type) -> TokenStream {
+    match t {
+        Type::Bool => quote!(false),
+        Type::Int(_) => int_lit(0, t).ts,
+        Type::Float(_) => float_lit(0.0, t).ts,
+        Type::Enum(_) | Type::Buffer(_) => {
+            let ty = rust_type(ir, names, t);
+            quote!(<#ty as ::core::default::Default>::default())
+        }
+        Type::Array(elem, n) => {
+            let z = zero(ir, names, elem);
+            let n = proc_macro2::Literal::usize_unsuffixed(*n as usize);
+            quote!([#z; #n])
+        }
+        Type::Status(_) => quote!(rt::Status::NOT_READY),
+        Type::Unit => quote!(()),
+    }
+}
+
+fn int_lit(v: i128, t: &Type) -> Code {
+    let suffix = match t {
+        Type::Int(i) => i.name(),
+        _ => "i64",
+    };
+    let lit: TokenStream = format!("{}{suffix}", v.unsigned_abs())
+        .parse()
+        .expect("integer literal");
+    if v < 0 {
+        Code {
+            ts: quote!(-#lit),
+            prec: UNARY,
+            has_block: false,
+        }
+    } else {
+        Code::atom(lit)
+    }
+}
+
+fn float_lit(v: f64, t: &Type) -> Code {
+    let text = match t {
+        Type::Float(FloatTy::F32) => format!("{:?}f32", (v.abs()) as f32),
+        _ => format!("{:?}f64", v.abs()),
+    };
+    let lit: TokenStream = text.parse().expect("float literal");
+    if v.is_sign_negative() && v != 0.0 {
+        Code {
+            ts: quote!(-#lit),
+            prec: UNARY,
+            has_block: false,
+        }
+    } else {
+        Code::atom(lit)
+    }
+}
+
+/// Fold a cast of a literal at generation time (clippy dislikes `1i64 as f32`).
+fn fold_cast(e: &Expr, to: &Type) -> Option<Code> {
+    match (&e.kind, to) {
+        (ExprKind::Int(v), Type::Int(it)) => {
+            // Rust `as` between integers keeps the low bits.
+            let bits = match it {
+                IntTy::I8 | IntTy::U8 => 8,
+                IntTy::I16 | IntTy::U16 => 16,
+                IntTy::I32 | IntTy::U32 => 32,
+                IntTy::I64 | IntTy::U64 => 64,
+            };
+            let masked = (*v as u128) & ((1u128 << bits) - 1);
+            let value = if it.signed() && masked >> (bits - 1) == 1 {
+                masked as i128 - (1i128 << bits)
+            } else {
+                masked as i128
+            };
+            Some(int_lit(value, to))
+        }
+        (ExprKind::Int(v), Type::Float(_)) => Some(float_lit(*v as f64, to)),
+        (ExprKind::Float(v), Type::Float(_)) => Some(float_lit(*v, to)),
+        (ExprKind::Float(v), Type::Int(it)) => {
+            // Rust `as` from float to integer saturates (NaN → 0).
+            let (lo, hi) = it.range();
+            let t = v.trunc();
+            let value = if t.is_nan() {
+                0
+            } else if t <= lo as f64 {
+                lo
+            } else if t >= hi as f64 {
+                hi
+            } else {
+                t as i128
+            };
+            Some(int_lit(value, to))
+        }
+        _ => None,
+    }
+}
+
+impl Gen<'_> {
+    fn cn(&self) -> &super::names::CtrlNames {
+        &self.names.ctrls[self.ci]
+    }
+
+    pub fn expr(&self, e: &Expr) -> Code {
+        match &e.kind {
+            ExprKind::Int(v) => int_lit(*v, &e.ty),
+            ExprKind::Float(v) => float_lit(*v, &e.ty),
+            ExprKind::Bool(b) => Code::atom(if *b { quote!(true) } else { quote!(false) }),
+            ExprKind::Variant(en, v) => {
+                let n = &self.names.enums[en.index()];
+                let (ty, var) = (&n.ty, &n.variants[*v as usize]);
+                Code::atom(quote!(super::types::#ty::#var))
+            }
+            ExprKind::Status(s) => {
+                let Type::Status(owner) = e.ty else {
+                    unreachable!("a status has a status type")
+                };
+                let module = &self.names.ctrls[owner.index()].module;
+                let c = &self.names.ctrls[owner.index()].status_consts[s.index()];
+                Code::atom(quote!(super::#module::status::#c))
+            }
+            ExprKind::NewCommand => Code::atom(quote!(self.bk.new_command())),
+            ExprKind::StateCycles => Code::atom(quote!(self.bk.state_cycles())),
+            ExprKind::PlanCycles => Code::atom(quote!(self.bk.plan_cycles())),
+            ExprKind::CmdParam(c, p) => {
+                let local = format_ident!(
+                    "cmd_{}",
+                    self.cn().params[c.index()][p.index()]
+                        .to_string()
+                        .trim_start_matches("r#")
+                );
+                Code::atom(quote!(#local))
+            }
+            ExprKind::Var(v) => {
+                let id = &self.cn().vars[v.index()];
+                Code::atom(quote!(self.data.vars.#id))
+            }
+            ExprKind::Buffer(b) => {
+                let id = self.cn().buffers[b.index()]
+                    .as_ref()
+                    .expect("buffer of this controller");
+                if self.ctrl.writes.contains(b) {
+                    Code::atom(quote!(self.data.writes.#id))
+                } else {
+                    Code::atom(quote!(self.data.reads.#id))
+                }
+            }
+            ExprKind::Field(base, f) => {
+                let b = self.expr(base);
+                let Type::Buffer(bt) = base.ty else {
+                    unreachable!("fields are on buffers")
+                };
+                let field = &self.names.buffers[bt.index()].fields[*f as usize];
+                let base = b.at(ATOM);
+                Code {
+                    ts: quote!(#base.#field),
+                    prec: ATOM,
+                    has_block: b.has_block,
+                }
+            }
+            ExprKind::Index(base, i) => {
+                let b = self.expr(base);
+                let base = b.at(ATOM);
+                let i = proc_macro2::Literal::usize_unsuffixed(*i as usize);
+                Code {
+                    ts: quote!(#base[#i]),
+                    prec: ATOM,
+                    has_block: b.has_block,
+                }
+            }
+            ExprKind::Call(h, args) => self.call(*h, args),
+            ExprKind::Sub(c, prop) => {
+                let i = self
+                    .ctrl
+                    .subordinates
+                    .iter()
+                    .position(|s| s == c)
+                    .expect("a subordinate");
+                let id = &self.cn().subs[i];
+                Code::atom(match prop {
+                    SubProp::Status => quote!(self.data.subs.#id.status),
+                    SubProp::Done => quote!(self.data.subs.#id.done()),
+                    SubProp::Executing => quote!(self.data.subs.#id.executing()),
+                    SubProp::Error => quote!(self.data.subs.#id.error()),
+                    SubProp::StaleCycles => quote!(self.data.subs.#id.stale_cycles),
+                })
+            }
+            ExprKind::Unary(op, x) => {
+                let c = self.expr(x);
+                match (op, &x.ty) {
+                    (UnOp::Neg, Type::Int(_)) => {
+                        let r = c.at(ATOM);
+                        Code {
+                            ts: quote!(#r.wrapping_neg()),
+                            prec: ATOM,
+                            has_block: c.has_block,
+                        }
+                    }
+                    (UnOp::Neg, _) => {
+                        let r = c.at(UNARY);
+                        Code {
+                            ts: quote!(-#r),
+                            prec: UNARY,
+                            has_block: c.has_block,
+                        }
+                    }
+                    (UnOp::Not, _) => {
+                        let r = c.at(UNARY);
+                        Code {
+                            ts: quote!(!#r),
+                            prec: UNARY,
+                            has_block: c.has_block,
+                        }
+                    }
+                }
+            }
+            ExprKind::Cast(x) => {
+                if x.ty == e.ty {
+                    return self.expr(x);
+                }
+                if let Some(folded) = fold_cast(x, &e.ty) {
+                    return folded;
+                }
+                let c = self.expr(x);
+                let inner = c.at(CAST);
+                let ty = rust_type(self.ir, self.names, &e.ty);
+                Code {
+                    ts: quote!(#inner as #ty),
+                    prec: CAST,
+                    has_block: c.has_block,
+                }
+            }
+            ExprKind::Binary(op, l, r) => self.binary(*op, l, r),
+        }
+    }
+
+    fn binary(&self, op: BinOp, l: &Expr, r: &Expr) -> Code {
+        // `x == true` and friends: clippy prefers the plain boolean.
+        if matches!(op, BinOp::Eq | BinOp::Ne) {
+            for (lit, other) in [(l, r), (r, l)] {
+                if let ExprKind::Bool(b) = lit.kind {
+                    let o = self.expr(other);
+                    if b == (op == BinOp::Eq) {
+                        return o;
+                    }
+                    let inner = o.at(UNARY);
+                    return Code {
+                        ts: quote!(!#inner),
+                        prec: UNARY,
+                        has_block: o.has_block,
+                    };
+                }
+            }
+        }
+        let a = self.expr(l);
+        let b = self.expr(r);
+        let has_block = a.has_block || b.has_block;
+        let int = matches!(l.ty, Type::Int(_));
+        let method = |m: &str| {
+            let m = format_ident!("{m}");
+            let recv = a.at(ATOM);
+            let arg = &b.ts;
+            quote!(#recv.#m(#arg))
+        };
+        let (ts, prec) = match op {
+            BinOp::Add if int => (method("wrapping_add"), ATOM),
+            BinOp::Sub if int => (method("wrapping_sub"), ATOM),
+            BinOp::Mul if int => (method("wrapping_mul"), ATOM),
+            BinOp::Div if int => {
+                let m = method("checked_div");
+                (quote!(#m.unwrap_or(0)), ATOM)
+            }
+            BinOp::Rem if int => {
+                let m = method("checked_rem");
+                (quote!(#m.unwrap_or(0)), ATOM)
+            }
+            _ => {
+                let p = match op {
+                    BinOp::Or => OR,
+                    BinOp::And => AND,
+                    BinOp::Add | BinOp::Sub => ADD,
+                    BinOp::Mul | BinOp::Div | BinOp::Rem => MUL,
+                    _ => CMP,
+                };
+                // Comparisons do not chain in Rust, and `a as T < b` parses
+                // `T<` as generics: both need parentheses.
+                let lmin = if p == CMP { CMP + 1 } else { p };
+                let mut lt = a.at(lmin);
+                if p == CMP && a.prec == CAST && matches!(op, BinOp::Lt | BinOp::Le) {
+                    let inner = &a.ts;
+                    lt = quote!((#inner));
+                }
+                let rt = b.at(p + 1);
+                let sym: TokenStream = op.symbol().parse().expect("operator");
+                (quote!(#lt #sym #rt), p)
+            }
+        };
+        Code {
+            ts,
+            prec,
+            has_block,
+        }
+    }
+
+    /// `self.hooks.name(&self.data, args…)`. Arguments that call hooks
+    /// themselves are evaluated first into locals (a block), because the
+    /// outer call already borrows the hooks mutably.
+    fn call(&self, h: HookId, args: &[Expr]) -> Code {
+        let name = &self.cn().hooks[h.index()];
+        let codes: Vec<Code> = args.iter().map(|a| self.expr(a)).collect();
+        let nested = args.iter().any(contains_call);
+        if !nested {
+            let ts: Vec<&TokenStream> = codes.iter().map(|c| &c.ts).collect();
+            let has_block = codes.iter().any(|c| c.has_block);
+            return Code {
+                ts: quote!(self.hooks.#name(&self.data #(, #ts)*)),
+                prec: ATOM,
+                has_block,
+            };
+        }
+        let locals: Vec<_> = (0..codes.len()).map(|i| format_ident!("arg{i}")).collect();
+        let ts: Vec<&TokenStream> = codes.iter().map(|c| &c.ts).collect();
+        Code {
+            ts: quote!({ #(let #locals = #ts;)* self.hooks.#name(&self.data #(, #locals)*) }),
+            prec: ATOM,
+            has_block: true,
+        }
+    }
+
+    pub fn place(&self, p: &Place) -> TokenStream {
+        let mut ts = match p.root {
+            PlaceRoot::Var(v) => {
+                let id = &self.cn().vars[v.index()];
+                quote!(self.data.vars.#id)
+            }
+            PlaceRoot::Buffer(b) => {
+                let id = self.cn().buffers[b.index()]
+                    .as_ref()
+                    .expect("buffer of this controller");
+                quote!(self.data.writes.#id)
+            }
+        };
+        let mut ty = match p.root {
+            PlaceRoot::Var(v) => self.ctrl.vars[v.index()].ty.clone(),
+            PlaceRoot::Buffer(b) => Type::Buffer(self.ir.buffers[b.index()].ty),
+        };
+        for proj in &p.path {
+            match (proj, &ty) {
+                (Projection::Field(f), Type::Buffer(bt)) => {
+                    let field = &self.names.buffers[bt.index()].fields[*f as usize];
+                    ts = quote!(#ts.#field);
+                    ty = self.ir.buffer_types[bt.index()].fields[*f as usize]
+                        .ty
+                        .clone();
+                }
+                (Projection::Index(i), Type::Array(elem, _)) => {
+                    let i = proc_macro2::Literal::usize_unsuffixed(*i as usize);
+                    ts = quote!(#ts[#i]);
+                    ty = (**elem).clone();
+                }
+                _ => unreachable!("projections follow the place's type"),
+            }
+        }
+        ts
+    }
+
+    /// `place = place OP rhs` with an arithmetic OP: the operator and `rhs`.
+    fn self_update<'e>(&self, place: &Place, value: &'e Expr) -> Option<(BinOp, &'e Expr)> {
+        let ExprKind::Binary(
+            op @ (BinOp::Add | BinOp::Sub | BinOp::Mul | BinOp::Div | BinOp::Rem),
+            l,
+            r,
+        ) = &value.kind
+        else {
+            return None;
+        };
+        same_place(place, l).then_some((*op, r))
+    }
+
+    pub fn job(&self, j: &Job) -> TokenStream {
+        match j {
+            Job::Assign {
+                place, op, value, ..
+            } => {
+                let target = self.place(place);
+                let v = self.expr(value);
+                let vt = &v.ts;
+                match (op, &place.ty) {
+                    // `x = x / k` on floats reads better (and passes clippy) as `x /= k`.
+                    (AssignOp::Set, Type::Float(_)) if self.self_update(place, value).is_some() => {
+                        let (op, rhs) = self.self_update(place, value).expect("checked");
+                        let rhs = self.expr(rhs).ts;
+                        let op: TokenStream =
+                            format!("{}=", op.symbol()).parse().expect("operator");
+                        quote!(#target #op #rhs;)
+                    }
+                    (AssignOp::Set, _) => quote!(#target = #vt;),
+                    (AssignOp::Add, Type::Int(_)) => quote!(#target = #target.wrapping_add(#vt);),
+                    (AssignOp::Sub, Type::Int(_)) => quote!(#target = #target.wrapping_sub(#vt);),
+                    (AssignOp::Add, _) => quote!(#target += #vt;),
+                    (AssignOp::Sub, _) => quote!(#target -= #vt;),
+                }
+            }
+            Job::Send {
+                sub, command, args, ..
+            } => {
+                let i = self
+                    .ctrl
+                    .subordinates
+                    .iter()
+                    .position(|s| s == sub)
+                    .expect("a subordinate");
+                let field = format_ident!(
+                    "sub_{}",
+                    self.cn().subs[i].to_string().trim_start_matches("r#")
+                );
+                let target = &self.names.ctrls[sub.index()];
+                let module = &target.module;
+                let variant = &target.commands[command.index()];
+                if args.is_empty() {
+                    quote!(self.#field.send(super::#module::Command::#variant);)
+                } else {
+                    let params = &target.params[command.index()];
+                    let vals: Vec<TokenStream> = args.iter().map(|a| self.expr(a).ts).collect();
+                    quote!(self.#field.send(super::#module::Command::#variant { #(#params: #vals),* });)
+                }
+            }
+            Job::Report { status, .. } => {
+                let c = &self.cn().status_consts[status.index()];
+                quote!(self.bk.report(status::#c);)
+            }
+            Job::Call(e) => {
+                let c = self.expr(e);
+                let ts = &c.ts;
+                quote!(#ts;)
+            }
+        }
+    }
+}
+
+/// Whether an expression reads exactly the given place.
+fn same_place(place: &Place, e: &Expr) -> bool {
+    let mut path = Vec::new();
+    let mut cur = e;
+    loop {
+        match &cur.kind {
+            ExprKind::Field(base, f) => {
+                path.push(Projection::Field(*f));
+                cur = base;
+            }
+            ExprKind::Index(base, i) => {
+                path.push(Projection::Index(*i));
+                cur = base;
+            }
+            ExprKind::Var(v) => {
+                path.reverse();
+                return place.root == PlaceRoot::Var(*v) && path == place.path;
+            }
+            ExprKind::Buffer(b) => {
+                path.reverse();
+                return place.root == PlaceRoot::Buffer(*b) && path == place.path;
+            }
+            _ => return false,
+        }
+    }
+}
+
+fn contains_call(e: &Expr) -> bool {
+    let mut found = false;
+    e.visit(&mut |x| found |= matches!(x.kind, ExprKind::Call(..)));
+    found
+}

@@ -1,0 +1,87 @@
+//! The plan set's enums and buffer schemas → `mod types`: plain `Copy`
+//! data that Global Memory can hold.
+
+use super::controller::derivable_default;
+use super::expr::{rust_type, zero};
+use super::names::Names;
+use proc_macro2::TokenStream;
+use quote::quote;
+use rcs_dsl::ir::Ir;
+
+fn docs(lines: &[String]) -> TokenStream {
+    let lines = lines.iter().map(|l| format!(" {l}"));
+    quote!(#(#[doc = #lines])*)
+}
+
+pub(crate) fn module(ir: &Ir, names: &Names) -> TokenStream {
+    let enums = ir.enums.iter().enumerate().map(|(i, e)| {
+        let n = &names.enums[i];
+        let ty = &n.ty;
+        let d = docs(&e.docs);
+        let variants = e.variants.iter().enumerate().map(|(vi, v)| {
+            let id = &n.variants[vi];
+            let vd = docs(&v.docs);
+            let default = if vi == 0 {
+                quote!(#[default])
+            } else {
+                quote!()
+            };
+            quote!(#vd #default #id)
+        });
+        let ids = &n.variants;
+        let texts: Vec<&str> = e.variants.iter().map(|v| v.name.as_str()).collect();
+        quote! {
+            #d
+            #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+            pub enum #ty { #(#variants),* }
+            impl #ty {
+                /// The variant's name as written in the plans.
+                pub const fn name(self) -> &'static str {
+                    match self { #(Self::#ids => #texts),* }
+                }
+            }
+        }
+    });
+    let buffers = ir.buffer_types.iter().enumerate().map(|(i, b)| {
+        let n = &names.buffers[i];
+        let ty = &n.ty;
+        let d = docs(&b.docs);
+        let fields = &n.fields;
+        let tys: Vec<TokenStream> = b
+            .fields
+            .iter()
+            .map(|f| rust_type(ir, names, &f.ty))
+            .collect();
+        let fdocs = b.fields.iter().map(|f| docs(&f.docs));
+        let derivable = b.fields.iter().all(|f| derivable_default(&f.ty));
+        let (derive, default_impl) = if derivable {
+            (quote!(Default,), quote!())
+        } else {
+            let zeros = b.fields.iter().map(|f| zero(ir, names, &f.ty));
+            (
+                quote!(),
+                quote! {
+                    impl Default for #ty {
+                        fn default() -> Self {
+                            Self { #(#fields: #zeros),* }
+                        }
+                    }
+                },
+            )
+        };
+        quote! {
+            #d
+            #[derive(Clone, Copy, Debug, #derive PartialEq)]
+            pub struct #ty { #(#fdocs pub #fields: #tys),* }
+            #default_impl
+        }
+    });
+    // Paths inside are `super::types::X`, which resolves from here too.
+    quote! {
+        /// The plan set's enums and Global Memory buffer schemas.
+        pub mod types {
+            #(#enums)*
+            #(#buffers)*
+        }
+    }
+}

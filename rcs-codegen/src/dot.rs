@@ -168,7 +168,7 @@ pub fn hierarchy_graph(ir: &Ir) -> String {
         for c in &cpu.order {
             let ctrl = ir.controller(*c);
             let mut label = html(&ctrl.name);
-            if let Some(t) = &ctrl.title {
+            if let Some(t) = ctrl.title.as_ref().filter(|t| !t.is_empty()) {
                 let _ = write!(label, "<BR/><FONT POINT-SIZE=\"9\">{}</FONT>", html(t));
             }
             if let Some(l) = ctrl.level {
@@ -199,11 +199,11 @@ pub fn hierarchy_graph(ir: &Ir) -> String {
 
 /// A period as people write it: `30 ms`, `500 µs`, `1 s`.
 pub fn period(ns: u64) -> String {
-    if ns % 1_000_000_000 == 0 {
+    if ns.is_multiple_of(1_000_000_000) {
         format!("{} s", ns / 1_000_000_000)
-    } else if ns % 1_000_000 == 0 {
+    } else if ns.is_multiple_of(1_000_000) {
         format!("{} ms", ns / 1_000_000)
-    } else if ns % 1_000 == 0 {
+    } else if ns.is_multiple_of(1_000) {
         format!("{} µs", ns / 1_000)
     } else {
         format!("{ns} ns")

@@ -72,7 +72,8 @@ impl StatusId {
 pub struct Ir {
     /// Name of the generated system module.
     pub system: String,
-    /// Display paths of the source files, in `FileId` order.
+    /// Source files relative to the plan set's root, in `FileId` order
+    /// (never absolute, so generated outputs do not depend on where the set lives).
     pub files: Vec<String>,
     pub limits: Limits,
     pub enums: Vec<EnumDef>,

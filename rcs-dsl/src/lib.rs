@@ -95,7 +95,19 @@ pub fn check(set: &PlanSet, options: &Options) -> Checked {
         .as_ref()
         .map(|(s, _)| s.clone())
         .unwrap_or_else(|| sanitize(&set.name));
-    let Some(ir) = lower::lower(&files, &set.manifest, &system, &set.sources, &mut diags) else {
+    let file_names = set
+        .sources
+        .files()
+        .map(|(id, _)| set.relative_path(id))
+        .collect();
+    let Some(ir) = lower::lower(
+        &files,
+        file_names,
+        &set.manifest,
+        &system,
+        &set.sources,
+        &mut diags,
+    ) else {
         return finish(None, diags);
     };
 

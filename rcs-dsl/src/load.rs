@@ -32,6 +32,10 @@ pub enum LoadError {
 pub struct PlanSet {
     /// The folder's name (default system name), or `plans` for loose files.
     pub name: String,
+    /// The plan-set folder as the user named it (`/`-separated); empty for
+    /// loose files and in-memory sets. Generated outputs name files
+    /// relative to it, so they never depend on where the set lives.
+    pub root: String,
     pub sources: SourceMap,
     /// The `.rcs` files, sorted by path.
     pub rcs_files: Vec<FileId>,
@@ -62,6 +66,23 @@ impl PlanSet {
             set.rcs_files.push(id);
         }
         set
+    }
+
+    /// A file's path relative to the set's root (its file name for loose files).
+    pub fn relative_path(&self, id: FileId) -> String {
+        let path = &self.sources.get(id).path;
+        let root = self.root.trim_end_matches('/');
+        if !root.is_empty() {
+            if let Some(rest) = path.strip_prefix(root).and_then(|r| r.strip_prefix('/')) {
+                return rest.to_string();
+            }
+        }
+        if self.root.is_empty() && !path.starts_with('/') {
+            if let Some(name) = std::path::Path::new(path).file_name() {
+                return name.to_string_lossy().into_owned();
+            }
+        }
+        path.rsplit('/').next().unwrap_or(path).to_string()
     }
 
     fn add_manifest(&mut self, path: &str, text: String) {
@@ -163,6 +184,7 @@ pub fn load_folder(root: &Path) -> Result<PlanSet, LoadError> {
         .unwrap_or_else(|| "plans".to_string());
     let mut set = PlanSet {
         name,
+        root: display(root),
         ..PlanSet::default()
     };
     let manifest_path = root.join("rcs.yaml");

@@ -83,7 +83,7 @@ pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments)
                 quote!(#d #default #v)
             } else {
                 let ps = &n.params[i];
-                let tys = k.params.iter().map(|p| rust_type(ir, names, &p.ty));
+                let tys = k.params.iter().map(|p| rust_type(names, &p.ty));
                 quote!(#d #default #v { #(#ps: #tys),* })
             }
         });
@@ -102,7 +102,7 @@ pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments)
         } else {
             let v = &n.commands[0];
             let ps = &n.params[0];
-            let zeros = c.commands[0].params.iter().map(|p| zero(ir, names, &p.ty));
+            let zeros = c.commands[0].params.iter().map(|p| zero(names, &p.ty));
             (
                 quote!(),
                 quote! {
@@ -187,12 +187,12 @@ pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments)
     let hook_fns = c.hooks.iter().enumerate().map(|(hi, h)| {
         let id = &n.hooks[hi];
         let ps = &n.hook_params[hi];
-        let tys = h.params.iter().map(|p| rust_type(ir, names, &p.ty));
+        let tys = h.params.iter().map(|p| rust_type(names, &p.ty));
         let d = docs(&h.docs);
         if h.ret == Type::Unit {
             quote!(#d fn #id(&mut self, data: &Data #(, #ps: #tys)*);)
         } else {
-            let ret = rust_type(ir, names, &h.ret);
+            let ret = rust_type(names, &h.ret);
             quote!(#d fn #id(&mut self, data: &Data #(, #ps: #tys)*) -> #ret;)
         }
     });
@@ -214,7 +214,7 @@ pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments)
     let read_tys: Vec<_> = c
         .reads
         .iter()
-        .map(|b| rust_type(ir, names, &Type::Buffer(ir.buffers[b.index()].ty)))
+        .map(|b| rust_type(names, &Type::Buffer(ir.buffers[b.index()].ty)))
         .collect();
     let write_fields: Vec<_> = c
         .writes
@@ -224,11 +224,11 @@ pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments)
     let write_tys: Vec<_> = c
         .writes
         .iter()
-        .map(|b| rust_type(ir, names, &Type::Buffer(ir.buffers[b.index()].ty)))
+        .map(|b| rust_type(names, &Type::Buffer(ir.buffers[b.index()].ty)))
         .collect();
     let sub_fields = &n.subs;
     let var_fields = &n.vars;
-    let var_tys: Vec<_> = c.vars.iter().map(|v| rust_type(ir, names, &v.ty)).collect();
+    let var_tys: Vec<_> = c.vars.iter().map(|v| rust_type(names, &v.ty)).collect();
     let var_docs: Vec<_> = c.vars.iter().map(|v| docs(&v.docs)).collect();
     let const_gen = Gen {
         ir,
@@ -245,7 +245,7 @@ pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments)
     } else {
         let inits = c.vars.iter().map(|v| match &v.init {
             Some(e) => const_gen.expr(e).ts,
-            None => zero(ir, names, &v.ty),
+            None => zero(names, &v.ty),
         });
         (
             quote!(),
@@ -580,7 +580,7 @@ fn plan_fn(
                     .to_string()
                     .trim_start_matches("r#")
             );
-            let ty = rust_type(ir, names, &param.ty);
+            let ty = rust_type(names, &param.ty);
             quote!(#local: #ty)
         })
         .collect();
@@ -592,11 +592,8 @@ fn plan_fn(
     };
     let printer = Printer::new(ir, c, Some(p));
     let state_ty = &pn.state_ty;
-    let file = ir.files[p.header.file.0 as usize]
-        .rsplit('/')
-        .next()
-        .unwrap_or("")
-        .to_string();
+    // Relative to the plan set's root: outputs never carry absolute paths.
+    let file = &ir.files[p.header.file.0 as usize];
 
     let row_code = |r: &Row, comments: &mut Comments| -> (Option<Code>, TokenStream) {
         let text = format!(

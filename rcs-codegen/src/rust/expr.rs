@@ -56,7 +56,7 @@ pub(crate) struct Gen<'a> {
     pub ci: usize,
 }
 
-pub(crate) fn rust_type(ir: &Ir, names: &Names, t: &Type) -> TokenStream {
+pub(crate) fn rust_type(names: &Names, t: &Type) -> TokenStream {
     match t {
         Type::Bool => quote!(bool),
         Type::Int(i) => {
@@ -76,7 +76,7 @@ pub(crate) fn rust_type(ir: &Ir, names: &Names, t: &Type) -> TokenStream {
             quote!(super::types::#id)
         }
         Type::Array(elem, n) => {
-            let elem = rust_type(ir, names, elem);
+            let elem = rust_type(names, elem);
             let n = proc_macro2::Literal::usize_unsuffixed(*n as usize);
             quote!([#elem; #n])
         }
@@ -86,17 +86,17 @@ pub(crate) fn rust_type(ir: &Ir, names: &Names, t: &Type) -> TokenStream {
 }
 
 /// The zero value of a type, as a constant expression.
-pub(crate) fn zero(ir: &Ir, names: &Names, t: &Type) -> TokenStream {
+pub(crate) fn zero(names: &Names, t: &Type) -> TokenStream {
     match t {
         Type::Bool => quote!(false),
         Type::Int(_) => int_lit(0, t).ts,
         Type::Float(_) => float_lit(0.0, t).ts,
         Type::Enum(_) | Type::Buffer(_) => {
-            let ty = rust_type(ir, names, t);
+            let ty = rust_type(names, t);
             quote!(<#ty as ::core::default::Default>::default())
         }
         Type::Array(elem, n) => {
-            let z = zero(ir, names, elem);
+            let z = zero(names, elem);
             let n = proc_macro2::Literal::usize_unsuffixed(*n as usize);
             quote!([#z; #n])
         }
@@ -308,7 +308,7 @@ impl Gen<'_> {
                 }
                 let c = self.expr(x);
                 let inner = c.at(CAST);
-                let ty = rust_type(self.ir, self.names, &e.ty);
+                let ty = rust_type(self.names, &e.ty);
                 Code {
                     ts: quote!(#inner as #ty),
                     prec: CAST,

@@ -47,17 +47,13 @@ pub(crate) fn module(ir: &Ir, names: &Names) -> TokenStream {
         let ty = &n.ty;
         let d = docs(&b.docs);
         let fields = &n.fields;
-        let tys: Vec<TokenStream> = b
-            .fields
-            .iter()
-            .map(|f| rust_type(ir, names, &f.ty))
-            .collect();
+        let tys: Vec<TokenStream> = b.fields.iter().map(|f| rust_type(names, &f.ty)).collect();
         let fdocs = b.fields.iter().map(|f| docs(&f.docs));
         let derivable = b.fields.iter().all(|f| derivable_default(&f.ty));
         let (derive, default_impl) = if derivable {
             (quote!(Default,), quote!())
         } else {
-            let zeros = b.fields.iter().map(|f| zero(ir, names, &f.ty));
+            let zeros = b.fields.iter().map(|f| zero(names, &f.ty));
             (
                 quote!(),
                 quote! {

@@ -41,6 +41,7 @@ pub(crate) const PRIMITIVES: [&str; 11] = [
 /// Lower parsed files (already in path order) to the IR.
 pub fn lower(
     files: &[ast::File],
+    file_names: Vec<String>,
     manifest: &Manifest,
     system: &str,
     sources: &SourceMap,
@@ -50,7 +51,7 @@ pub fn lower(
     let globals = collect_items(files, diags);
     let mut ir = Ir {
         system: system.to_string(),
-        files: sources.files().map(|(_, f)| f.path.clone()).collect(),
+        files: file_names,
         limits: manifest.limits,
         enums: Vec::new(),
         buffer_types: Vec::new(),

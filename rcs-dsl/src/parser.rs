@@ -223,7 +223,13 @@ fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>) -> Diagno
     } else {
         format!("expected {}, found {found}", one_of(&expected))
     };
-    Diagnostic::error(
+    // `h ()`, `ship .speed`, `a [0]`: postfix parts must touch their name.
+    let before = text[..pos.min(text.len())].trim_end_matches([' ', '\t']);
+    let spaced_postfix = before.len() < pos
+        && matches!(text[pos..].chars().next(), Some('(' | '[' | '.' | ':'))
+        && before
+            .ends_with(|c: char| c.is_ascii_alphanumeric() || c == '_' || c == ')' || c == ']');
+    let diagnostic = Diagnostic::error(
         Code::Syntax,
         message,
         Span::new(file, pos, end),
@@ -232,7 +238,12 @@ fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>) -> Diagno
         } else {
             format!("expected {}", one_of(&expected))
         },
-    )
+    );
+    if spaced_postfix {
+        diagnostic.with_help("write calls, fields, indices and `Enum::Variant` without spaces: `h()`, `ship.speed`, `a[0]`")
+    } else {
+        diagnostic
+    }
 }
 
 fn one_of(words: &[String]) -> String {
@@ -267,7 +278,7 @@ fn rule_words(rule: Rule) -> Option<&'static str> {
         Rule::target => "a target (a state, `same`, `Done` or `Error(…)`)",
         Rule::error_target | Rule::error_word => "`Error`",
         Rule::jobs => "a job list `{ … }`",
-        Rule::job | Rule::send_job | Rule::report_job | Rule::expr_job => "a job",
+        Rule::job | Rule::report_job | Rule::expr_job => "a job",
         Rule::assign_op => "`=`, `+=` or `-=`",
         Rule::send_arrow => "`<-`",
         Rule::arrow => "`->`",
@@ -654,7 +665,7 @@ impl Builder {
         let span = self.span(&p);
         let mut docs = Vec::new();
         let mut label = None;
-        let mut body = None;
+        let mut body = Vec::new();
         for c in p.into_inner() {
             match c.as_rule() {
                 Rule::doc_comment => docs.push(Self::doc(&c)),
@@ -663,27 +674,30 @@ impl Builder {
                     let n = c.as_str()[1..].parse::<u64>().unwrap_or(u64::MAX);
                     label = Some((n, s));
                 }
-                _ => body = Some(c),
+                _ => body.push(c),
             }
         }
-        let body = body.expect("row has a body");
-        let otherwise = body.as_rule() == Rule::otherwise_row;
-        let mut from = From::Implicit;
+        let mut from = None;
+        let mut otherwise = None;
+        let mut when = None;
         let mut cond = None;
         let mut cond_span = span;
         let mut target = None;
         let mut jobs = Vec::new();
-        for c in body.into_inner() {
+        for c in body {
             match c.as_rule() {
-                Rule::dont_care => from = self.dont_care(c),
                 Rule::from_state => {
                     let c = c.into_inner().next().expect("from has one child");
-                    from = match c.as_rule() {
+                    from = Some(match c.as_rule() {
                         Rule::dont_care => self.dont_care(c),
                         _ => From::State(self.name(c)),
-                    };
+                    });
                 }
-                Rule::kw_otherwise => cond_span = self.span(&c),
+                Rule::kw_otherwise => {
+                    cond_span = self.span(&c);
+                    otherwise = Some(cond_span);
+                }
+                Rule::kw_when => when = Some(self.span(&c)),
                 Rule::expr => {
                     cond_span = self.span(&c);
                     cond = Some(self.expr(c));
@@ -693,7 +707,31 @@ impl Builder {
                 _ => {}
             }
         }
-        debug_assert!(otherwise == cond.is_none());
+        let from = match (from, otherwise) {
+            (Some(From::State(n)), Some(_)) => {
+                self.error(
+                    n.span,
+                    format!("an `otherwise` row cannot start in state `{}`", n.text),
+                    "`otherwise` applies in every state",
+                );
+                self.diags.last_mut().expect("just pushed").help =
+                    Some("write `otherwise -> …` or `*N otherwise -> …`".to_string());
+                From::Implicit
+            }
+            (Some(f), _) => f,
+            (None, Some(_)) => From::Implicit,
+            (None, None) => {
+                self.error(
+                    when.unwrap_or(cond_span),
+                    "expected a state or `*` before `when`",
+                    "this row names no state",
+                );
+                self.diags.last_mut().expect("just pushed").help =
+                    Some("start the row with the state it applies in (`S1 when …`) or `*` for every state".to_string());
+                From::Implicit
+            }
+        };
+        debug_assert!(otherwise.is_some() == cond.is_none());
         Row {
             docs,
             label,
@@ -734,35 +772,50 @@ impl Builder {
         let c = p.into_inner().next().expect("job has one child");
         let span = self.span(&c);
         match c.as_rule() {
-            Rule::send_job => {
-                let mut inner = c.into_inner();
-                let sub = self.name(inner.next().expect("subordinate"));
-                inner.next(); // <-
-                let verb = self.name(inner.next().expect("verb"));
-                let args = inner
-                    .map(|a| {
-                        let mut ai = a.into_inner();
-                        let n = self.name(ai.next().expect("arg name"));
-                        let e = self.expr(ai.next().expect("arg value"));
-                        (n, e)
-                    })
-                    .collect();
-                Job::Send {
-                    sub,
-                    verb,
-                    args,
-                    span,
-                }
-            }
             Rule::report_job => {
                 let n = self.name(c.into_inner().nth(1).expect("status"));
                 Job::Report(n, span)
             }
             _ => {
                 let mut inner = c.into_inner();
-                let place = self.postfix(inner.next().expect("place"), 0).0;
+                let first = inner.next().expect("place");
                 match inner.next() {
+                    Some(arrow) if arrow.as_rule() == Rule::send_arrow => {
+                        // `X <- VERB(args)`: the name before `<-` is the subordinate.
+                        let sub_span = self.span(&first);
+                        let place = self.postfix(first, 0).0;
+                        let sub = match place.kind {
+                            ExprKind::Path(None, n) => n,
+                            _ => {
+                                self.error(
+                                    sub_span,
+                                    "expected a subordinate's name before `<-`",
+                                    "not a controller name",
+                                );
+                                Name {
+                                    text: String::new(),
+                                    span: sub_span,
+                                }
+                            }
+                        };
+                        let verb = self.name(inner.next().expect("verb"));
+                        let args = inner
+                            .map(|a| {
+                                let mut ai = a.into_inner();
+                                let n = self.name(ai.next().expect("arg name"));
+                                let e = self.expr(ai.next().expect("arg value"));
+                                (n, e)
+                            })
+                            .collect();
+                        Job::Send {
+                            sub,
+                            verb,
+                            args,
+                            span,
+                        }
+                    }
                     Some(op) => {
+                        let place = self.postfix(first, 0).0;
                         let op = match op.as_str() {
                             "+=" => AssignOp::Add,
                             "-=" => AssignOp::Sub,
@@ -777,6 +830,7 @@ impl Builder {
                         }
                     }
                     None => {
+                        let place = self.postfix(first, 0).0;
                         if !matches!(place.kind, ExprKind::Call(..)) {
                             self.error(
                                 span,

@@ -1,0 +1,72 @@
+//! Compile every plan set of the repository (`plans/*` and the golden ok
+//! cases `tests/data/ok/*`) through `rcs_codegen::Config`, as a user's
+//! build.rs would. The workspace's `cargo clippy -D warnings` then checks
+//! every generated module. Also builds the C port of the methodology's
+//! controller template for the benchmark.
+
+use std::path::{Path, PathBuf};
+
+fn module_name(path: &Path) -> String {
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let s: String = stem
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    format!("set_{s}")
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let out = PathBuf::from(std::env::var("OUT_DIR")?);
+    let mut includes = String::new();
+    for folder in ["../../plans", "../../tests/data/ok"] {
+        let mut entries: Vec<PathBuf> = std::fs::read_dir(folder)?
+            .map(|e| e.map(|e| e.path()))
+            .collect::<Result<_, _>>()?;
+        entries.sort();
+        for path in entries {
+            let name = path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            let is_set = path.is_dir() && name != "snapshots"
+                || path.extension().is_some_and(|e| e == "rcs");
+            if !is_set {
+                continue;
+            }
+            let module = module_name(&path);
+            let dest = out.join("sets").join(&module);
+            rcs_codegen::Config::new()
+                .out_dir(&dest)
+                .graphs(false)
+                .compile(&path)?;
+            let rust = std::fs::read_dir(dest.join("rust"))?
+                .map(|e| e.map(|e| e.path()))
+                .collect::<Result<Vec<_>, _>>()?;
+            let [rust] = rust.as_slice() else {
+                return Err(format!("{}: expected one generated Rust file", path.display()).into());
+            };
+            includes.push_str(&format!(
+                "pub mod {module} {{\n    include!({:?});\n}}\n",
+                rust.display().to_string()
+            ));
+        }
+    }
+    std::fs::write(out.join("sets.rs"), includes)?;
+
+    println!("cargo::rerun-if-changed=c/pr_template.c");
+    cc::Build::new()
+        .file("c/pr_template.c")
+        .opt_level(2)
+        .warnings(true)
+        .compile("pr_template");
+    Ok(())
+}

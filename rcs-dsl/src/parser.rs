@@ -361,7 +361,7 @@ impl Builder {
     /// A user-chosen name; reserved words are refused here (see grammar.pest).
     fn name(&mut self, p: Pair<Rule>) -> Name {
         let name = Name {
-            text: p.as_str().to_string(),
+            text: p.as_str().into(),
             span: self.span(&p),
         };
         if RESERVED.contains(&name.text.as_str()) {
@@ -793,7 +793,7 @@ impl Builder {
                                     "not a controller name",
                                 );
                                 Name {
-                                    text: String::new(),
+                                    text: Default::default(),
                                     span: sub_span,
                                 }
                             }
@@ -1014,7 +1014,7 @@ impl Builder {
                     kind: ExprKind::Field(
                         Box::new(e),
                         Name {
-                            text: c.as_str().to_string(),
+                            text: c.as_str().into(),
                             span: self.span(&c),
                         },
                     ),
@@ -1074,7 +1074,7 @@ impl Builder {
                     ("cmd", None) => ExprKind::Path(
                         None,
                         Name {
-                            text: "cmd".to_string(),
+                            text: "cmd".into(),
                             span,
                         },
                     ),

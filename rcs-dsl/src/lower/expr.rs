@@ -41,12 +41,12 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
         for e in &c.entries {
             match &e.kind {
                 ast::EntryKind::Reads(n, _) | ast::EntryKind::Writes(n, _) => {
-                    values.push((n.text.clone(), n.span))
+                    values.push((n.text.to_string(), n.span))
                 }
                 ast::EntryKind::Subordinates(ns) => {
                     for n in ns {
                         if !values.iter().any(|(v, _)| *v == n.text) {
-                            values.push((n.text.clone(), n.span));
+                            values.push((n.text.to_string(), n.span));
                         }
                     }
                 }
@@ -65,7 +65,7 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                 diags.push(duplicate(what, &name.text, later, earlier));
                 false
             } else {
-                values.push((name.text.clone(), name.span));
+                values.push((name.text.to_string(), name.span));
                 true
             }
         };
@@ -78,7 +78,7 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                         continue;
                     }
                     commands.push(Command {
-                        name: name.text.clone(),
+                        name: name.text.to_string(),
                         docs: docs.clone(),
                         params: lower_params(g, params, diags),
                         plan: None,
@@ -103,7 +103,7 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                             continue;
                         }
                         statuses.push(StatusDef {
-                            name: name.text.clone(),
+                            name: name.text.to_string(),
                             docs: docs.clone(),
                             span: Some(name.span),
                         });
@@ -116,7 +116,7 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                             continue;
                         }
                         errors.push(ErrorDef {
-                            name: name.text.clone(),
+                            name: name.text.to_string(),
                             docs: docs.clone(),
                             span: name.span,
                         });
@@ -128,7 +128,7 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                     }
                     let ty = resolve_type(g, ty, diags);
                     vars.push(Var {
-                        name: name.text.clone(),
+                        name: name.text.to_string(),
                         docs: docs.clone(),
                         // Unresolved: keep the var so its uses do not cascade.
                         ty: ty.unwrap_or(Type::Unit),
@@ -146,7 +146,7 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                         None => Type::Unit,
                     };
                     hooks.push(Hook {
-                        name: name.text.clone(),
+                        name: name.text.to_string(),
                         docs: docs.clone(),
                         params,
                         ret,
@@ -179,7 +179,7 @@ fn lower_params(g: &Globals, params: &[ast::Param], diags: &mut Diagnostics) -> 
         }
         let ty = resolve_type(g, &p.ty, diags).unwrap_or(Type::Unit);
         out.push(Param {
-            name: p.name.text.clone(),
+            name: p.name.text.to_string(),
             ty,
             span: p.name.span,
         });
@@ -208,7 +208,7 @@ pub(super) fn lower_controller_body(
                 ast::EntryKind::Hook {
                     name, ret: Some(t), ..
                 } if resolve_type(g, t, &mut Diagnostics::new()).is_none() => {
-                    Some(name.text.clone())
+                    Some(name.text.to_string())
                 }
                 _ => None,
             })
@@ -1315,7 +1315,7 @@ impl Cx<'_, '_> {
                 }
                 None => {
                     states.push(State {
-                        name: n.text.clone(),
+                        name: n.text.to_string(),
                         span: Some(n.span),
                     });
                     StateId(states.len() as u32 - 1)

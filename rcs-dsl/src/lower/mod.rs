@@ -149,7 +149,7 @@ fn lower_enums(g: &Globals, ir: &mut Ir, diags: &mut Diagnostics) {
                 continue;
             }
             variants.push(Variant {
-                name: v.text.clone(),
+                name: v.text.to_string(),
                 docs: docs.clone(),
                 span: v.span,
             });
@@ -166,7 +166,7 @@ fn lower_enums(g: &Globals, ir: &mut Ir, diags: &mut Diagnostics) {
             );
         }
         ir.enums.push(EnumDef {
-            name: e.name.text.clone(),
+            name: e.name.text.to_string(),
             docs: e.outer.docs.clone(),
             variants,
             span: e.span,
@@ -265,14 +265,14 @@ fn lower_buffer_types(g: &Globals, ir: &mut Ir, diags: &mut Diagnostics) {
             // cascade neither into unknown-field errors nor type mismatches.
             let ty = resolve_type(g, &f.ty, diags).unwrap_or(Type::Unit);
             fields.push(FieldDef {
-                name: f.name.text.clone(),
+                name: f.name.text.to_string(),
                 docs: f.docs.clone(),
                 ty,
                 span: f.name.span,
             });
         }
         ir.buffer_types.push(BufferType {
-            name: b.name.text.clone(),
+            name: b.name.text.to_string(),
             docs: b.outer.docs.clone(),
             fields,
             span: b.span,
@@ -332,7 +332,7 @@ fn lower_controller_headers<'a>(
     // Shells first, so subordinates can be resolved in any order.
     for c in &g.controllers {
         ir.controllers.push(Controller {
-            name: c.name.text.clone(),
+            name: c.name.text.to_string(),
             title: c.title.clone(),
             docs: c.outer.docs.clone(),
             level: None,
@@ -505,7 +505,7 @@ fn lower_controller_headers<'a>(
                                 // it declares: a stand-in entry keeps its uses
                                 // from cascading (no IR is produced anyway).
                                 ir.buffers.push(Buffer {
-                                    name: name.text.clone(),
+                                    name: name.text.to_string(),
                                     ty: bty,
                                     writer: None,
                                     readers: Vec::new(),
@@ -518,7 +518,7 @@ fn lower_controller_headers<'a>(
                         }
                         None => {
                             ir.buffers.push(Buffer {
-                                name: name.text.clone(),
+                                name: name.text.to_string(),
                                 ty: bty,
                                 writer: None,
                                 readers: Vec::new(),

@@ -295,12 +295,28 @@ pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments)
                 quote!(#local)
             })
             .collect();
-        Some(if k.params.is_empty() {
-            quote!(Command::#v => self.#func())
+        let subs_arg = if uses_subs(&c.plans[pid.index()]) {
+            quote!(subs)
         } else {
-            quote!(Command::#v { #(#binds,)* .. } => self.#func(#(#locals),*))
+            quote!()
+        };
+        let sep = if uses_subs(&c.plans[pid.index()]) && !locals.is_empty() {
+            quote!(,)
+        } else {
+            quote!()
+        };
+        Some(if k.params.is_empty() {
+            quote!(Command::#v => self.#func(#subs_arg))
+        } else {
+            quote!(Command::#v { #(#binds,)* .. } => self.#func(#subs_arg #sep #(#locals),*))
         })
     });
+    let any_subs = c.plans.iter().any(uses_subs);
+    let subs_param = if any_subs {
+        quote!(subs)
+    } else {
+        quote!(_subs)
+    };
     let decide = if c.commands.is_empty() {
         quote!(
             fn decide(&mut self) {}
@@ -308,7 +324,7 @@ pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments)
     } else {
         quote! {
             /// Step 4: the plan of the active command picks at most one row.
-            fn decide(&mut self) {
+            fn decide(&mut self, #subs_param: Subs) {
                 match self.data.command { #(#decide_arms,)* }
             }
         }
@@ -348,6 +364,19 @@ pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments)
         .map(|s| &names.ctrls[s.index()].module)
         .collect();
     let verb_count_lit = proc_macro2::Literal::usize_unsuffixed(verb_count);
+    // The six steps of a cycle (SEMANTICS.md), as comments in the output.
+    let step1 = comments.marker(
+        "1. Read: the command, every read buffer and every subordinate's status, once.".to_string(),
+    );
+    let step2 = comments.marker(
+        "2. Handshake view of each subordinate; rows read this local copy, hooks see `data.subs`."
+            .to_string(),
+    );
+    let step3 = comments.marker("3. A new serial starts the plan of its verb in S0.".to_string());
+    let step4 = comments.marker("4. Decide: the active plan fires at most one row.".to_string());
+    let step5 =
+        comments.marker("5. Write: status, written buffers, commands sent this cycle.".to_string());
+    let step6 = comments.marker("6. Account: state and plan cycle counters, timing.".to_string());
 
     quote! {
         #mod_docs
@@ -508,25 +537,26 @@ pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments)
                 fn name(&self) -> &str { NAME }
 
                 fn cycle(&mut self, ctx: &rt::CycleContext) {
-                    // 1. Read: copy in the command, every read buffer and every subordinate's status once.
+                    #step1
                     let command = self.command_in.read().value;
                     #(self.data.reads.#read_fields = self.#read_handles.read().value;)*
-                    // 2. The handshake view of each subordinate.
-                    #(self.data.subs.#sub_fields = self.#sub_handles.read();)*
-                    // 3. A new serial starts the plan of its verb in S0.
+                    #step2
+                    let subs = Subs { #(#sub_fields: self.#sub_handles.read()),* };
+                    self.data.subs = subs;
+                    #step3
                     self.bk.begin_cycle(ctx.tick(), &command, true);
                     if self.bk.new_command() {
                         self.data.command = command.command;
                     }
-                    // 4. Decide.
+                    #step4
                     if self.bk.is_active() {
-                        self.decide();
+                        self.decide(subs);
                     }
-                    // 5. Write: status, written buffers, commands sent this cycle.
+                    #step5
                     self.status_out.write(self.bk.status_buffer(), ctx.cycle);
                     #(self.#write_handles.write(self.data.writes.#write_fields, ctx.cycle);)*
                     #(self.#sub_handles.flush(ctx.cycle);)*
-                    // 6. Account.
+                    #step6
                     self.bk.end_cycle();
                 }
 
@@ -534,6 +564,15 @@ pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments)
             }
         }
     }
+}
+
+/// Whether a plan reads a subordinate's status.
+fn uses_subs(p: &Plan) -> bool {
+    let mut used = false;
+    for r in &p.rows {
+        r.visit_exprs(&mut |e| used |= matches!(e.kind, ExprKind::Sub(..)));
+    }
+    used
 }
 
 /// The parameters of the plan's command that its rows read.
@@ -591,6 +630,11 @@ fn plan_fn(
         ci,
     };
     let printer = Printer::new(ir, c, Some(p));
+    let subs_param = if uses_subs(p) {
+        quote!(subs: Subs,)
+    } else {
+        quote!()
+    };
     let state_ty = &pn.state_ty;
     // Relative to the plan set's root: outputs never carry absolute paths.
     let file = &ir.files[p.header.file.0 as usize];
@@ -733,7 +777,7 @@ fn plan_fn(
             clippy::manual_range_contains,
             clippy::approx_constant
         )]
-        fn #func(&mut self #(, #args)*) {
+        fn #func(&mut self, #subs_param #(#args),*) {
             #body
         }
     }

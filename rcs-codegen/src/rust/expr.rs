@@ -263,11 +263,12 @@ impl Gen<'_> {
                     .expect("a subordinate");
                 let id = &self.cn().subs[i];
                 Code::atom(match prop {
-                    SubProp::Status => quote!(self.data.subs.#id.status),
-                    SubProp::Done => quote!(self.data.subs.#id.done()),
-                    SubProp::Executing => quote!(self.data.subs.#id.executing()),
-                    SubProp::Error => quote!(self.data.subs.#id.error()),
-                    SubProp::StaleCycles => quote!(self.data.subs.#id.stale_cycles),
+                    // `subs`: the cycle's local copy (see the controller's `cycle`).
+                    SubProp::Status => quote!(subs.#id.status),
+                    SubProp::Done => quote!(subs.#id.done()),
+                    SubProp::Executing => quote!(subs.#id.executing()),
+                    SubProp::Error => quote!(subs.#id.error()),
+                    SubProp::StaleCycles => quote!(subs.#id.stale_cycles),
                 })
             }
             ExprKind::Unary(op, x) => {

@@ -18,6 +18,7 @@ extern crate alloc;
 pub mod ast;
 mod checks;
 pub mod diagnostic;
+pub mod interp;
 pub mod ir;
 pub mod lint;
 pub mod load;

@@ -1,0 +1,591 @@
+//! The reference interpreter: runs one controller of a validated IR per
+//! SEMANTICS.md, cycle by cycle, with its inputs, hook results and
+//! subordinates' statuses supplied from outside (a scenario, a test).
+//!
+//! New-command detection, the handshake view, the counters and finishing
+//! are not implemented here: they are `rcs_runtime`'s `Bookkeeping` and
+//! `SubordinateLink`, the same code generated controllers call, so that the
+//! semantics exist once. Arithmetic follows the generated code exactly:
+//! integers wrap at their declared width, division or remainder by zero
+//! (or `MIN / -1`) gives 0, `f32` arithmetic is rounded to `f32`, and `as`
+//! behaves like Rust's (integers keep their low bits, floats saturate).
+
+use crate::ast::{AssignOp, BinOp, UnOp};
+use crate::ir::*;
+use rcs_runtime::{
+    Bookkeeping, ErrorCode, Stamped, Status, StatusBuffer, SubordinateLink, SubordinateView, Tick,
+};
+
+/// A run-time value. Integers are kept in range of their type; `f32`
+/// values are kept exactly representable as `f32`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[serde(untagged)]
+pub enum Value {
+    Bool(bool),
+    Int(i128),
+    Float(f64),
+    /// An enum variant by index.
+    Enum(u32),
+    /// A status code (`rcs_runtime::Status`).
+    Status(u16),
+    /// A buffer's fields in declaration order.
+    Buffer(Vec<Value>),
+    Array(Vec<Value>),
+    Unit,
+}
+
+impl Value {
+    /// The zero value of a type: numbers 0, `false`, the first variant.
+    pub fn zero(ir: &Ir, t: &Type) -> Value {
+        match t {
+            Type::Bool => Value::Bool(false),
+            Type::Int(_) => Value::Int(0),
+            Type::Float(_) => Value::Float(0.0),
+            Type::Enum(_) => Value::Enum(0),
+            Type::Status(_) => Value::Status(0),
+            Type::Buffer(b) => Value::Buffer(
+                ir.buffer_types[b.index()]
+                    .fields
+                    .iter()
+                    .map(|f| Value::zero(ir, &f.ty))
+                    .collect(),
+            ),
+            Type::Array(e, n) => Value::Array(vec![Value::zero(ir, e); *n as usize]),
+            Type::Unit => Value::Unit,
+        }
+    }
+
+    pub fn as_bool(&self) -> bool {
+        matches!(self, Value::Bool(true))
+    }
+}
+
+/// An integer wrapped into the range of its type (keeps the low bits).
+pub fn wrap(v: i128, t: IntTy) -> i128 {
+    let bits = match t {
+        IntTy::I8 | IntTy::U8 => 8,
+        IntTy::I16 | IntTy::U16 => 16,
+        IntTy::I32 | IntTy::U32 => 32,
+        IntTy::I64 | IntTy::U64 => 64,
+    };
+    let masked = (v as u128) & ((1u128 << bits) - 1);
+    if t.signed() && masked >> (bits - 1) == 1 {
+        masked as i128 - (1i128 << bits)
+    } else {
+        masked as i128
+    }
+}
+
+fn round(v: f64, t: FloatTy) -> f64 {
+    match t {
+        FloatTy::F32 => v as f32 as f64,
+        FloatTy::F64 => v,
+    }
+}
+
+/// Rust's `as` from a float to an integer: truncate, saturate, NaN → 0.
+fn float_to_int(v: f64, t: IntTy) -> i128 {
+    if v.is_nan() {
+        return 0;
+    }
+    let (lo, hi) = t.range();
+    let t = v.trunc();
+    if t <= lo as f64 {
+        lo
+    } else if t >= hi as f64 {
+        hi
+    } else {
+        t as i128
+    }
+}
+
+/// What a hook sees of its controller, read-only (as generated hooks see `&Data`).
+pub struct HookData<'a> {
+    pub ctrl: &'a Controller,
+    /// Parameters of the command being executed.
+    pub params: &'a [Value],
+    /// `reads` buffers, in declaration order.
+    pub reads: &'a [Value],
+    pub vars: &'a [Value],
+    /// `writes` buffers, in declaration order.
+    pub writes: &'a [Value],
+}
+
+/// Where a controller's hooks come from: a scenario, a test, a model.
+pub trait Hooks {
+    /// The result of calling `hook` with `args` (`Value::Unit` for hooks
+    /// that return nothing).
+    fn call(&mut self, data: &HookData, hook: HookId, args: &[Value]) -> Value;
+}
+
+/// A command a cycle sent to a subordinate.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Sent {
+    pub sub: CtrlId,
+    pub command: CommandId,
+    pub args: Vec<Value>,
+    pub serial: u32,
+}
+
+/// What one cycle did and left behind.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct CycleRecord {
+    pub cycle: u64,
+    /// The active verb (if a plan is or was active).
+    pub verb: Option<CommandId>,
+    pub fired: Option<RowId>,
+    pub state: StateId,
+    pub status: StatusId,
+    /// `None`: no error code.
+    pub error: Option<u16>,
+    pub sent: Vec<Sent>,
+    pub vars: Vec<Value>,
+    /// Values of the controller's `writes` buffers, in declaration order.
+    pub writes: Vec<Value>,
+}
+
+struct SubState {
+    link: SubordinateLink,
+    status: Stamped<StatusBuffer>,
+    view: SubordinateView,
+}
+
+/// One controller, interpreted.
+pub struct Interpreter<'ir> {
+    ctrl: &'ir Controller,
+    bk: Bookkeeping,
+    cycle: u64,
+    /// The supervisor's command buffer: serial, verb, parameters.
+    command: (u32, CommandId, Vec<Value>),
+    /// The parameters of the command being executed.
+    active_params: Vec<Value>,
+    vars: Vec<Value>,
+    reads: Vec<Value>,
+    writes: Vec<Value>,
+    subs: Vec<SubState>,
+}
+
+impl<'ir> Interpreter<'ir> {
+    /// Controller `ctrl` with vars at their initialisers and every buffer zero.
+    pub fn new(ir: &'ir Ir, ctrl: CtrlId) -> Interpreter<'ir> {
+        let c = ir.controller(ctrl);
+        let mut me = Interpreter {
+            ctrl: c,
+            bk: Bookkeeping::new(c.commands.len()),
+            cycle: 0,
+            command: (0, CommandId(0), Vec::new()),
+            active_params: Vec::new(),
+            vars: Vec::new(),
+            reads: c
+                .reads
+                .iter()
+                .map(|b| Value::zero(ir, &Type::Buffer(ir.buffers[b.index()].ty)))
+                .collect(),
+            writes: c
+                .writes
+                .iter()
+                .map(|b| Value::zero(ir, &Type::Buffer(ir.buffers[b.index()].ty)))
+                .collect(),
+            subs: c
+                .subordinates
+                .iter()
+                .map(|_| SubState {
+                    link: SubordinateLink::new(),
+                    status: Stamped::default(),
+                    view: SubordinateView::default(),
+                })
+                .collect(),
+        };
+        let mut no_hooks = NoHooks;
+        me.vars = c
+            .vars
+            .iter()
+            .map(|v| match &v.init {
+                Some(e) => me.eval(e, &mut no_hooks),
+                None => Value::zero(ir, &v.ty),
+            })
+            .collect();
+        me
+    }
+
+    pub fn controller(&self) -> &'ir Controller {
+        self.ctrl
+    }
+
+    /// The supervisor writes a new command (the next serial).
+    pub fn command(&mut self, command: CommandId, params: Vec<Value>) -> u32 {
+        let serial = rcs_runtime::next_serial(self.command.0);
+        self.command = (serial, command, params);
+        serial
+    }
+
+    /// The supervisor's command buffer as it stands: serial, verb, parameters.
+    pub fn command_buffer(&self) -> &(u32, CommandId, Vec<Value>) {
+        &self.command
+    }
+
+    /// Set a `reads` buffer (by its index in the controller's `reads`).
+    pub fn set_read(&mut self, index: usize, value: Value) {
+        self.reads[index] = value;
+    }
+
+    pub fn reads(&self) -> &[Value] {
+        &self.reads
+    }
+
+    /// A subordinate (by its index in `subordinates`) writes its status
+    /// buffer; each write is a new generation.
+    pub fn write_sub_status(&mut self, index: usize, status: StatusBuffer) {
+        let s = &mut self.subs[index].status;
+        s.value = status;
+        s.generation += 1;
+        s.writer_cycle = self.cycle;
+    }
+
+    /// The serial of the last command this controller sent a subordinate.
+    pub fn last_sent(&self, index: usize) -> u32 {
+        self.subs[index].link.last_sent()
+    }
+
+    pub fn bookkeeping(&self) -> &Bookkeeping {
+        &self.bk
+    }
+
+    pub fn vars(&self) -> &[Value] {
+        &self.vars
+    }
+
+    pub fn writes(&self) -> &[Value] {
+        &self.writes
+    }
+
+    /// One control cycle (SEMANTICS.md steps 1–6).
+    pub fn cycle(&mut self, hooks: &mut dyn Hooks) -> CycleRecord {
+        // 1–2. Read; the handshake view of each subordinate.
+        for s in &mut self.subs {
+            s.view = s.link.observe(&s.status);
+        }
+        // 3. New command.
+        let (serial, verb, params) = self.command.clone();
+        let has_plan = self
+            .ctrl
+            .commands
+            .get(verb.index())
+            .is_some_and(|c| c.plan.is_some());
+        self.bk
+            .begin_cycle_raw(Tick::now(self.cycle), serial, verb.0 as u16, has_plan);
+        if self.bk.new_command() {
+            self.active_params = params;
+        }
+        // 4. Decide.
+        let mut sent = Vec::new();
+        if self.bk.is_active() {
+            self.decide(hooks, &mut sent);
+        }
+        // 5. Write (the record), 6. account.
+        let record = CycleRecord {
+            cycle: self.cycle,
+            verb: (self.bk.echo_serial() != 0).then_some(CommandId(self.bk.verb() as u32)),
+            fired: self.bk.fired().map(|r| RowId(r as u32)),
+            state: StateId(self.bk.state() as u32),
+            status: StatusId(self.bk.status().0 as u32),
+            error: (!self.bk.error().is_none()).then_some(self.bk.error().0),
+            sent,
+            vars: self.vars.clone(),
+            writes: self.writes.clone(),
+        };
+        self.bk.end_cycle();
+        self.cycle += 1;
+        record
+    }
+
+    fn decide(&mut self, hooks: &mut dyn Hooks, sent: &mut Vec<Sent>) {
+        let ctrl = self.ctrl;
+        let Some(plan) = ctrl.commands[self.bk.verb() as usize]
+            .plan
+            .map(|p| &ctrl.plans[p.index()])
+        else {
+            return;
+        };
+        let state = StateId(self.bk.state() as u32);
+        let mut chosen = None;
+        for r in plan.rows.iter().filter(|r| !r.is_otherwise()) {
+            let from_ok = match r.from {
+                From::DontCare(_) => true,
+                From::State(s) => s == state,
+            };
+            if !from_ok {
+                continue;
+            }
+            if let Condition::When(c) = &r.cond {
+                if self.eval(c, hooks).as_bool() {
+                    chosen = Some(r);
+                    break;
+                }
+            }
+        }
+        let Some(row) = chosen.or_else(|| plan.otherwise()) else {
+            return;
+        };
+        for j in &row.jobs {
+            self.job(j, hooks, sent);
+        }
+        let target = match row.to {
+            Target::State(s) => rcs_runtime::Target::State(s.0 as u16),
+            Target::Same => rcs_runtime::Target::Same,
+            Target::Done => rcs_runtime::Target::Done,
+            Target::Error(None) => rcs_runtime::Target::Error(ErrorCode::NONE),
+            Target::Error(Some(e)) => rcs_runtime::Target::Error(ErrorCode::custom(e.0 as u16)),
+        };
+        self.bk.fire(row.position as u16, target);
+    }
+
+    fn job(&mut self, j: &Job, hooks: &mut dyn Hooks, sent: &mut Vec<Sent>) {
+        match j {
+            Job::Assign {
+                place, op, value, ..
+            } => {
+                let v = self.eval(value, hooks);
+                let slot = self.place_mut(place);
+                let new = match (op, &place.ty) {
+                    (AssignOp::Set, _) => v,
+                    (_, Type::Int(t)) => {
+                        let (Value::Int(a), Value::Int(b)) = (&*slot, &v) else {
+                            return;
+                        };
+                        Value::Int(wrap(
+                            if *op == AssignOp::Add {
+                                a.wrapping_add(*b)
+                            } else {
+                                a.wrapping_sub(*b)
+                            },
+                            *t,
+                        ))
+                    }
+                    (_, Type::Float(t)) => {
+                        let (Value::Float(a), Value::Float(b)) = (&*slot, &v) else {
+                            return;
+                        };
+                        Value::Float(round(if *op == AssignOp::Add { a + b } else { a - b }, *t))
+                    }
+                    _ => v,
+                };
+                *self.place_mut(place) = new;
+            }
+            Job::Send {
+                sub, command, args, ..
+            } => {
+                let args: Vec<Value> = args.iter().map(|a| self.eval(a, hooks)).collect();
+                let i = self
+                    .ctrl
+                    .subordinates
+                    .iter()
+                    .position(|s| s == sub)
+                    .expect("a subordinate");
+                let serial = self.subs[i].link.next_command();
+                sent.push(Sent {
+                    sub: *sub,
+                    command: *command,
+                    args,
+                    serial,
+                });
+            }
+            Job::Report { status, .. } => self.bk.report(Status(status.0 as u16)),
+            Job::Call(e) => {
+                self.eval(e, hooks);
+            }
+        }
+    }
+
+    fn place_mut(&mut self, p: &Place) -> &mut Value {
+        let mut slot = match p.root {
+            PlaceRoot::Var(v) => &mut self.vars[v.index()],
+            PlaceRoot::Buffer(b) => {
+                let i = self
+                    .ctrl
+                    .writes
+                    .iter()
+                    .position(|w| *w == b)
+                    .expect("a written buffer");
+                &mut self.writes[i]
+            }
+        };
+        for proj in &p.path {
+            slot = match (proj, slot) {
+                (Projection::Field(f), Value::Buffer(fs)) => &mut fs[*f as usize],
+                (Projection::Index(i), Value::Array(es)) => &mut es[*i as usize],
+                (_, other) => return other,
+            };
+        }
+        slot
+    }
+
+    /// Evaluate an expression of this controller (left to right, `&&` and
+    /// `||` short-circuit, so hook calls happen in a defined order).
+    pub fn eval(&mut self, e: &Expr, hooks: &mut dyn Hooks) -> Value {
+        match &e.kind {
+            ExprKind::Int(v) => Value::Int(*v),
+            ExprKind::Float(v) => Value::Float(match e.ty {
+                Type::Float(t) => round(*v, t),
+                _ => *v,
+            }),
+            ExprKind::Bool(b) => Value::Bool(*b),
+            ExprKind::Variant(_, v) => Value::Enum(*v),
+            ExprKind::Status(s) => Value::Status(s.0 as u16),
+            ExprKind::NewCommand => Value::Bool(self.bk.new_command()),
+            ExprKind::StateCycles => Value::Int(self.bk.state_cycles() as i128),
+            ExprKind::PlanCycles => Value::Int(self.bk.plan_cycles() as i128),
+            ExprKind::CmdParam(_, p) => self
+                .active_params
+                .get(p.index())
+                .cloned()
+                .unwrap_or(Value::Unit),
+            ExprKind::Var(v) => self.vars[v.index()].clone(),
+            ExprKind::Buffer(b) => {
+                if let Some(i) = self.ctrl.writes.iter().position(|w| w == b) {
+                    self.writes[i].clone()
+                } else {
+                    let i = self
+                        .ctrl
+                        .reads
+                        .iter()
+                        .position(|r| r == b)
+                        .expect("a read buffer");
+                    self.reads[i].clone()
+                }
+            }
+            ExprKind::Field(base, f) => match self.eval(base, hooks) {
+                Value::Buffer(mut fs) => fs.swap_remove(*f as usize),
+                other => other,
+            },
+            ExprKind::Index(base, i) => match self.eval(base, hooks) {
+                Value::Array(mut es) => es.swap_remove(*i as usize),
+                other => other,
+            },
+            ExprKind::Call(h, args) => {
+                let args: Vec<Value> = args.iter().map(|a| self.eval(a, hooks)).collect();
+                let data = HookData {
+                    ctrl: self.ctrl,
+                    params: &self.active_params,
+                    reads: &self.reads,
+                    vars: &self.vars,
+                    writes: &self.writes,
+                };
+                hooks.call(&data, *h, &args)
+            }
+            ExprKind::Sub(c, prop) => {
+                let i = self
+                    .ctrl
+                    .subordinates
+                    .iter()
+                    .position(|s| s == c)
+                    .expect("a subordinate");
+                let v = self.subs[i].view;
+                match prop {
+                    SubProp::Status => Value::Status(v.status.0),
+                    SubProp::Done => Value::Bool(v.done()),
+                    SubProp::Executing => Value::Bool(v.executing()),
+                    SubProp::Error => Value::Bool(v.error()),
+                    SubProp::StaleCycles => Value::Int(v.stale_cycles as i128),
+                }
+            }
+            ExprKind::Unary(op, x) => {
+                let v = self.eval(x, hooks);
+                match (op, v, &e.ty) {
+                    (UnOp::Not, Value::Bool(b), _) => Value::Bool(!b),
+                    (UnOp::Neg, Value::Int(i), Type::Int(t)) => {
+                        Value::Int(wrap(i.wrapping_neg(), *t))
+                    }
+                    (UnOp::Neg, Value::Float(f), _) => Value::Float(-f),
+                    (_, v, _) => v,
+                }
+            }
+            ExprKind::Cast(x) => {
+                let v = self.eval(x, hooks);
+                match (v, &e.ty) {
+                    (Value::Int(i), Type::Int(t)) => Value::Int(wrap(i, *t)),
+                    (Value::Int(i), Type::Float(t)) => Value::Float(round(i as f64, *t)),
+                    (Value::Float(f), Type::Int(t)) => Value::Int(float_to_int(f, *t)),
+                    (Value::Float(f), Type::Float(t)) => Value::Float(round(f, *t)),
+                    (v, _) => v,
+                }
+            }
+            ExprKind::Binary(op, l, r) => self.binary(*op, l, r, &e.ty, hooks),
+        }
+    }
+
+    fn binary(&mut self, op: BinOp, l: &Expr, r: &Expr, ty: &Type, hooks: &mut dyn Hooks) -> Value {
+        match op {
+            BinOp::And => {
+                return Value::Bool(self.eval(l, hooks).as_bool() && self.eval(r, hooks).as_bool())
+            }
+            BinOp::Or => {
+                return Value::Bool(self.eval(l, hooks).as_bool() || self.eval(r, hooks).as_bool())
+            }
+            _ => {}
+        }
+        let a = self.eval(l, hooks);
+        let b = self.eval(r, hooks);
+        match op {
+            BinOp::Eq => Value::Bool(a == b),
+            BinOp::Ne => Value::Bool(a != b),
+            BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge => {
+                let ord = match (&a, &b) {
+                    (Value::Int(x), Value::Int(y)) => x.partial_cmp(y),
+                    (Value::Float(x), Value::Float(y)) => x.partial_cmp(y),
+                    _ => None,
+                };
+                Value::Bool(match (op, ord) {
+                    (_, None) => false,
+                    (BinOp::Lt, Some(o)) => o.is_lt(),
+                    (BinOp::Le, Some(o)) => o.is_le(),
+                    (BinOp::Gt, Some(o)) => o.is_gt(),
+                    (_, Some(o)) => o.is_ge(),
+                })
+            }
+            _ => match (a, b, ty) {
+                (Value::Int(x), Value::Int(y), Type::Int(t)) => Value::Int(wrap(
+                    match op {
+                        BinOp::Add => x.wrapping_add(y),
+                        BinOp::Sub => x.wrapping_sub(y),
+                        BinOp::Mul => x.wrapping_mul(y),
+                        // The generated code's `checked_div(..).unwrap_or(0)`:
+                        // zero for a zero divisor and for `MIN / -1`.
+                        BinOp::Div => checked(x, y, *t, i128::checked_div),
+                        _ => checked(x, y, *t, i128::checked_rem),
+                    },
+                    *t,
+                )),
+                (Value::Float(x), Value::Float(y), Type::Float(t)) => Value::Float(round(
+                    match op {
+                        BinOp::Add => x + y,
+                        BinOp::Sub => x - y,
+                        BinOp::Mul => x * y,
+                        BinOp::Div => x / y,
+                        _ => x % y,
+                    },
+                    *t,
+                )),
+                (a, _, _) => a,
+            },
+        }
+    }
+}
+
+/// Integer division or remainder with Rust's checked semantics at width `t`.
+fn checked(x: i128, y: i128, t: IntTy, f: fn(i128, i128) -> Option<i128>) -> i128 {
+    let (lo, _) = t.range();
+    if y == 0 || (t.signed() && x == lo && y == -1) {
+        return 0;
+    }
+    f(x, y).unwrap_or(0)
+}
+
+/// Hooks for constant contexts (var initialisers call none).
+struct NoHooks;
+
+impl Hooks for NoHooks {
+    fn call(&mut self, _: &HookData, _: HookId, _: &[Value]) -> Value {
+        Value::Unit
+    }
+}

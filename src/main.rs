@@ -15,7 +15,8 @@ use std::time::Instant;
 #[command(
     name = "rcsc",
     version,
-    about = "Compiler and toolchain for NIST RCS controller plans"
+    about = "Compiler and toolchain for NIST RCS controller plans",
+    after_help = MAIN_HELP
 )]
 struct Cli {
     #[command(subcommand)]
@@ -32,7 +33,56 @@ enum Command {
     /// Check plan sets, then write their state graphs, state tables and Rust code.
     #[command(after_help = BUILD_HELP)]
     Build(BuildArgs),
+    /// Print one state graph (or the controller hierarchy) as DOT or SVG.
+    #[command(after_help = GRAPH_HELP)]
+    Graph(GraphArgs),
+    /// Print the validated intermediate representation, for other tools.
+    #[command(after_help = IR_HELP)]
+    Ir(IrArgs),
 }
+
+const MAIN_HELP: &str = "\
+A PATH is a plan-set folder (every *.rcs below it, plus its optional rcs.yaml)
+or one or more .rcs files; the default is the current folder.
+
+Exit status: 0 success (warnings allowed), 1 a diagnostic with an error,
+2 a usage or I/O problem (with a one-line reason).
+
+Examples:
+  rcsc check plans/submarine
+  rcsc build plans/submarine -o target/rcs
+  rcsc graph plans/submarine --plan PR.AHEAD --format svg -o ahead.svg
+  rcsc ir plans/submarine --format json
+
+Run `rcsc help <COMMAND>` for a command's options and more examples.";
+
+const GRAPH_HELP: &str = "\
+The plans are checked first; diagnostics are printed as by `rcsc check` (on
+stderr, in every format, since stdout carries the graph) and an error stops
+the command with exit status 1. An unknown CTRL.VERB is a usage problem
+(exit status 2) whose message lists the plans there are.
+
+`--format svg` runs Graphviz `dot -Tsvg` on the DOT text; install the
+`graphviz` package for it, or render the DOT yourself.
+
+Examples:
+  rcsc graph plans/submarine --plan PR.AHEAD
+  rcsc graph plans/submarine --plan PR.AHEAD --format svg -o ahead.svg
+  rcsc graph plans/submarine --hierarchy | dot -Tpng -o hierarchy.png
+  rcsc graph plans/figure13/figure13.rcs --plan GX.RUN";
+
+const IR_HELP: &str = "\
+The plans are checked first; diagnostics are printed as by `rcsc check` (on
+stderr, in every format, since stdout carries the IR) and an error stops the
+command with exit status 1. One plan set gives one IR object; several give a
+list of them, in the order named. Entities refer to each other by index
+(`controllers[i]`, `plans[i]`, `states[i]`, ...); spans are byte ranges
+`{file, start, end}` into `files[file]`, relative to the plan-set folder.
+
+Examples:
+  rcsc ir plans/submarine
+  rcsc ir plans/submarine --format json -o submarine.json
+  rcsc ir plans/submarine --format json | jq '.controllers[].name'";
 
 const BUILD_HELP: &str = "\
 Every plan set is checked first; if any has an error, the diagnostics are
@@ -68,12 +118,72 @@ struct BuildArgs {
     #[arg(
         short = 'o',
         long = "out-dir",
+        visible_alias = "out",
         value_name = "DIR",
         default_value = "target/rcs"
     )]
     out_dir: PathBuf,
     #[command(flatten)]
     common: Common,
+}
+
+#[derive(Args)]
+#[command(group = clap::ArgGroup::new("what").required(true).args(["plan", "hierarchy"]))]
+struct GraphArgs {
+    /// Plan-set folders (using their rcs.yaml) or .rcs files [default: .]
+    paths: Vec<PathBuf>,
+    /// The plan to draw: a controller and one of its command verbs.
+    #[arg(long, value_name = "CTRL.VERB", value_parser = parse_plan_name)]
+    plan: Option<(String, String)>,
+    /// Draw the controller hierarchy (one cluster per CPU) instead of a plan.
+    #[arg(long)]
+    hierarchy: bool,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = GraphFormat::Dot)]
+    format: GraphFormat,
+    /// Write to FILE instead of stdout.
+    #[arg(short = 'o', long = "out", value_name = "FILE")]
+    out: Option<PathBuf>,
+    #[command(flatten)]
+    common: Common,
+}
+
+#[derive(Args)]
+struct IrArgs {
+    /// Plan-set folders (using their rcs.yaml) or .rcs files [default: .]
+    paths: Vec<PathBuf>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = IrFormat::Yaml)]
+    format: IrFormat,
+    /// Write to FILE instead of stdout.
+    #[arg(short = 'o', long = "out", value_name = "FILE")]
+    out: Option<PathBuf>,
+    #[command(flatten)]
+    common: Common,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum GraphFormat {
+    Dot,
+    Svg,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum IrFormat {
+    Yaml,
+    Json,
+}
+
+/// `CTRL.VERB` → (CTRL, VERB).
+fn parse_plan_name(s: &str) -> Result<(String, String), String> {
+    match s.split_once('.') {
+        Some((c, v)) if !c.is_empty() && !v.is_empty() && !v.contains('.') => {
+            Ok((c.to_string(), v.to_string()))
+        }
+        _ => Err(format!(
+            "`{s}` is not CTRL.VERB (a controller and one of its commands, e.g. PR.AHEAD)"
+        )),
+    }
 }
 
 #[derive(Args)]
@@ -158,6 +268,8 @@ fn main() -> ExitCode {
     match cli.command {
         Command::Check(args) => check(args),
         Command::Build(args) => build(args),
+        Command::Graph(args) => graph(args),
+        Command::Ir(args) => ir(args),
     }
 }
 
@@ -182,11 +294,13 @@ struct Counts {
     warnings: usize,
 }
 
-/// Print one plan set's diagnostics (warnings only when not quiet).
+/// Print one plan set's diagnostics (warnings only when not quiet). JSON
+/// goes to stdout unless `stdout_busy` (the command prints its product there).
 fn print_diagnostics(
     set: &rcs_dsl::PlanSet,
     checked: &rcs_dsl::Checked,
     common: &Common,
+    stdout_busy: bool,
     counts: &mut Counts,
 ) {
     let format = common.format();
@@ -204,7 +318,7 @@ fn print_diagnostics(
         let text = render::render(d, &set.sources, format);
         // Machine formats go to stdout; human text to stderr, as rustc does.
         let _ = match format {
-            Format::Json => out.write_all(text.as_bytes()),
+            Format::Json if !stdout_busy => out.write_all(text.as_bytes()),
             _ => err.write_all(text.as_bytes()),
         };
     }
@@ -229,7 +343,7 @@ fn check(args: CheckArgs) -> ExitCode {
     let mut counts = Counts::default();
     for set in &sets {
         let checked = rcs_dsl::check(set, &options);
-        print_diagnostics(set, &checked, &args.common, &mut counts);
+        print_diagnostics(set, &checked, &args.common, false, &mut counts);
     }
     print_summary(&args.common, &counts);
     if counts.errors > 0 {
@@ -298,7 +412,7 @@ fn build(args: BuildArgs) -> ExitCode {
             ),
         );
         let checked = rcs_dsl::check(set, &options);
-        print_diagnostics(set, &checked, &args.common, &mut counts);
+        print_diagnostics(set, &checked, &args.common, false, &mut counts);
         irs.push(checked.ir);
     }
     print_summary(&args.common, &counts);
@@ -354,6 +468,177 @@ fn output_files(irs: &[rcs_dsl::ir::Ir]) -> Result<Vec<rcs_codegen::OutputFile>,
         }));
     }
     Ok(files)
+}
+
+/// Load and check plan sets for a command that prints a product on stdout
+/// (`graph`, `ir`): diagnostics go to stderr. `Err` is the exit status when
+/// the plans cannot be read (2) or have an error (1).
+fn checked_irs(
+    paths: Vec<PathBuf>,
+    common: &Common,
+) -> Result<Vec<(rcs_dsl::PlanSet, rcs_dsl::ir::Ir)>, ExitCode> {
+    let sets = rcs_dsl::load_paths(&default_paths(paths)).map_err(fail)?;
+    let options = common.options();
+    let mut counts = Counts::default();
+    let mut out = Vec::with_capacity(sets.len());
+    for set in sets {
+        let checked = rcs_dsl::check(&set, &options);
+        print_diagnostics(&set, &checked, common, true, &mut counts);
+        if let Some(ir) = checked.ir {
+            out.push((set, ir));
+        }
+    }
+    print_summary(common, &counts);
+    if counts.errors > 0 {
+        return Err(ExitCode::from(1));
+    }
+    Ok(out)
+}
+
+/// Write a command's product to `out` (a file) or to stdout.
+fn emit(out: Option<&std::path::Path>, bytes: &[u8]) -> ExitCode {
+    let result = match out {
+        Some(path) => std::fs::write(path, bytes)
+            .map_err(|e| format!("cannot write {}: {e}", rcs_dsl::load::display(path))),
+        None => {
+            let mut stdout = std::io::stdout().lock();
+            match stdout.write_all(bytes).and_then(|()| stdout.flush()) {
+                // A closed pipe (`rcsc ir | head`) is the reader's choice, not a failure.
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+                r => r.map_err(|e| format!("cannot write to stdout: {e}")),
+            }
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(reason) => fail(reason),
+    }
+}
+
+/// Every `CTRL.VERB` with a plan, in declaration order.
+fn plan_names(irs: &[(rcs_dsl::PlanSet, rcs_dsl::ir::Ir)]) -> Vec<String> {
+    let mut names = Vec::new();
+    for (_, ir) in irs {
+        for c in &ir.controllers {
+            for cmd in c.commands.iter().filter(|cmd| cmd.plan.is_some()) {
+                names.push(format!("{}.{}", c.name, cmd.name));
+            }
+        }
+    }
+    names
+}
+
+fn graph(args: GraphArgs) -> ExitCode {
+    let irs = match checked_irs(args.paths, &args.common) {
+        Ok(irs) => irs,
+        Err(code) => return code,
+    };
+    let dot = match &args.plan {
+        Some((ctrl_name, verb)) => {
+            let found: Vec<String> = irs
+                .iter()
+                .filter_map(|(_, ir)| {
+                    let ctrl = ir.controller(ir.controller_by_name(ctrl_name)?);
+                    let plan = ctrl.plan_of(verb)?;
+                    Some(rcs_codegen::dot::plan_graph(ir, ctrl, plan))
+                })
+                .collect();
+            match <[String; 1]>::try_from(found) {
+                Ok([dot]) => dot,
+                Err(found) if found.is_empty() => {
+                    let names = plan_names(&irs);
+                    let known = if names.is_empty() {
+                        "there are no plans".to_string()
+                    } else {
+                        format!("the plans are: {}", names.join(", "))
+                    };
+                    return fail(format!("no plan `{ctrl_name}.{verb}`; {known}"));
+                }
+                Err(_) => {
+                    return fail(format!(
+                        "`{ctrl_name}.{verb}` is in several plan sets; name only the one to draw"
+                    ))
+                }
+            }
+        }
+        None => match irs.as_slice() {
+            [(_, ir)] => rcs_codegen::dot::hierarchy_graph(ir),
+            [] => return fail("no plan set to draw"),
+            _ => {
+                return fail(
+                    "--hierarchy draws one plan set, but several were named; name only one",
+                )
+            }
+        },
+    };
+    let bytes = match args.format {
+        GraphFormat::Dot => dot.into_bytes(),
+        GraphFormat::Svg => match render_svg(&dot) {
+            Ok(svg) => svg,
+            Err(reason) => return fail(reason),
+        },
+    };
+    emit(args.out.as_deref(), &bytes)
+}
+
+/// DOT → SVG through Graphviz `dot`, the one program the CLI runs.
+fn render_svg(dot: &str) -> Result<Vec<u8>, String> {
+    use std::process::{Command, Stdio};
+    let mut child = Command::new("dot")
+        .arg("-Tsvg")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| match e.kind() {
+            std::io::ErrorKind::NotFound => "Graphviz `dot` not found: install the `graphviz` \
+                package (e.g. apt-get install graphviz) or use --format dot"
+                .to_string(),
+            _ => format!("cannot run Graphviz `dot`: {e}"),
+        })?;
+    // Feed stdin from a thread so a large graph cannot deadlock on full pipes.
+    let mut stdin = child.stdin.take().expect("stdin is piped");
+    let input = dot.to_string();
+    let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
+    let output = child
+        .wait_with_output()
+        .map_err(|e| format!("cannot run Graphviz `dot`: {e}"))?;
+    let written = writer
+        .join()
+        .unwrap_or_else(|e| std::panic::resume_unwind(e));
+    if !output.status.success() {
+        let why = String::from_utf8_lossy(&output.stderr);
+        let why = why.lines().next().unwrap_or("").trim();
+        return Err(format!(
+            "Graphviz `dot -Tsvg` failed ({}): {why}",
+            output.status
+        ));
+    }
+    written.map_err(|e| format!("cannot feed Graphviz `dot`: {e}"))?;
+    Ok(output.stdout)
+}
+
+fn ir(args: IrArgs) -> ExitCode {
+    let irs = match checked_irs(args.paths, &args.common) {
+        Ok(irs) => irs,
+        Err(code) => return code,
+    };
+    let irs: Vec<&rcs_dsl::ir::Ir> = irs.iter().map(|(_, ir)| ir).collect();
+    let text = match (args.format, irs.as_slice()) {
+        (IrFormat::Json, [one]) => serde_json::to_string_pretty(one).map_err(|e| e.to_string()),
+        (IrFormat::Json, all) => serde_json::to_string_pretty(all).map_err(|e| e.to_string()),
+        (IrFormat::Yaml, [one]) => rcs_dsl::manifest::to_yaml(one).map_err(|e| e.to_string()),
+        (IrFormat::Yaml, all) => rcs_dsl::manifest::to_yaml(&all).map_err(|e| e.to_string()),
+    };
+    match text {
+        Ok(mut text) => {
+            if !text.ends_with('\n') {
+                text.push('\n');
+            }
+            emit(args.out.as_deref(), text.as_bytes())
+        }
+        Err(e) => fail(format!("cannot serialise the IR: {e}")),
+    }
 }
 
 #[cfg(test)]

@@ -229,6 +229,12 @@ pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>>
     }
 }
 
+/// Any serialisable value as YAML (`rcsc ir`), through the same library
+/// that reads manifests, so the project has one YAML dependency.
+pub fn to_yaml<T: serde::Serialize>(value: &T) -> Result<String, serde_saphyr::SerializeError> {
+    serde_saphyr::to_string(value)
+}
+
 /// `30ms`, `1.5s`, `500us`/`500µs`, `100ns`, in nanoseconds.
 pub fn parse_duration(text: &str) -> Option<u64> {
     let text = text.trim();

@@ -1,0 +1,258 @@
+//! The documentation is tested like code:
+//!
+//! - every ```rcs block of `docs/language.md` checks as it says: a plain
+//!   `rcs` block with no diagnostic at all, an `rcs expect=CODE, …` block with
+//!   exactly those codes (`rcs fragment` blocks are not checked); a
+//!   ```yaml expect=… block is the `rcs.yaml` of the `rcs` block before it;
+//! - every diagnostic code has an example and a section there;
+//! - `docs/ahead.svg`, the state graph shown in the README, is what
+//!   `rcsc graph plans/submarine --plan PR.AHEAD --format svg` draws today
+//!   (`UPDATE_DOCS=1 cargo test --test docs` rewrites it);
+//! - the README gives the two commands of the project.
+
+use rcs_dsl::lint::Lint;
+use rcs_dsl::render::{self, Format};
+use rcs_dsl::{Code, Options};
+use std::collections::BTreeSet;
+use std::process::Command;
+
+/// One fenced block: its info string words, its text and its first line.
+struct Block {
+    lang: String,
+    attrs: Vec<String>,
+    text: String,
+    line: usize,
+}
+
+fn blocks(markdown: &str) -> Vec<Block> {
+    let mut out = Vec::new();
+    let mut current: Option<Block> = None;
+    for (i, line) in markdown.lines().enumerate() {
+        let trimmed = line.trim_start();
+        match current.take() {
+            None => {
+                if let Some(info) = trimmed.strip_prefix("```") {
+                    let mut words = info.split_whitespace().map(str::to_string);
+                    current = Some(Block {
+                        lang: words.next().unwrap_or_default(),
+                        attrs: words.collect(),
+                        text: String::new(),
+                        line: i + 2,
+                    });
+                }
+            }
+            Some(mut b) => {
+                if trimmed.starts_with("```") {
+                    out.push(b);
+                } else {
+                    b.text.push_str(line);
+                    b.text.push('\n');
+                    current = Some(b);
+                }
+            }
+        }
+    }
+    assert!(current.is_none(), "an unclosed ``` block");
+    out
+}
+
+impl Block {
+    /// `expect=a,b` (also `expect=a, b` split over words), if given.
+    fn expected(&self) -> Option<BTreeSet<String>> {
+        let joined = self.attrs.join(" ");
+        let rest = joined.split_once("expect=")?.1;
+        Some(
+            rest.split(',')
+                .map(|s| s.trim().to_string())
+                .filter(|s| !s.is_empty())
+                .collect(),
+        )
+    }
+
+    fn is_fragment(&self) -> bool {
+        self.attrs.iter().any(|a| a == "fragment")
+    }
+}
+
+/// Check one plan set made of `rcs` (as `example.rcs`) and an optional manifest;
+/// returns the codes found and their short rendering.
+fn check(rcs: &str, manifest: Option<&str>) -> (BTreeSet<String>, String) {
+    let set = rcs_dsl::PlanSet::from_texts("example", [("example.rcs", rcs)], manifest);
+    let checked = rcs_dsl::check(&set, &Options::default());
+    let codes = checked
+        .diagnostics
+        .iter()
+        .map(|d| d.code.name().to_string())
+        .collect();
+    let text = checked
+        .diagnostics
+        .iter()
+        .map(|d| render::render(d, &set.sources, Format::Short))
+        .collect();
+    (codes, text)
+}
+
+fn language_md() -> String {
+    std::fs::read_to_string("docs/language.md").expect("docs/language.md exists")
+}
+
+#[test]
+fn every_example_in_the_language_reference_checks_as_it_says() {
+    let doc = language_md();
+    let mut previous_rcs: Option<String> = None;
+    let mut checked = 0;
+    let mut failures = Vec::new();
+    for b in blocks(&doc) {
+        match b.lang.as_str() {
+            "rcs" if b.is_fragment() => {}
+            "rcs" => {
+                let want = b.expected().unwrap_or_default();
+                let (got, text) = check(&b.text, None);
+                if got != want {
+                    failures.push(format!(
+                        "docs/language.md:{}: expected {want:?}, got {got:?}\n{text}",
+                        b.line
+                    ));
+                }
+                previous_rcs = Some(b.text.clone());
+                checked += 1;
+            }
+            "yaml" => match b.expected() {
+                Some(want) => {
+                    let rcs = previous_rcs.as_deref().unwrap_or_else(|| {
+                        panic!("docs/language.md:{}: no rcs block before it", b.line)
+                    });
+                    let (got, text) = check(rcs, Some(&b.text));
+                    if got != want {
+                        failures.push(format!(
+                            "docs/language.md:{}: expected {want:?}, got {got:?}\n{text}",
+                            b.line
+                        ));
+                    }
+                    checked += 1;
+                }
+                None => {
+                    // A reference manifest: it must at least be a valid one.
+                    let file = rcs_dsl::source::SourceFile::new("rcs.yaml", b.text.clone());
+                    if let Err(ds) = rcs_dsl::manifest::parse(rcs_dsl::source::FileId(0), &file) {
+                        failures.push(format!(
+                            "docs/language.md:{}: not a valid manifest: {:?}",
+                            b.line,
+                            ds.iter().map(|d| &d.message).collect::<Vec<_>>()
+                        ));
+                    }
+                }
+            },
+            _ => {}
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    assert!(checked >= 30, "only {checked} examples were checked");
+}
+
+#[test]
+fn every_diagnostic_code_has_a_section_and_an_example() {
+    let doc = language_md();
+    let shown: BTreeSet<String> = blocks(&doc)
+        .iter()
+        .filter_map(Block::expected)
+        .flatten()
+        .collect();
+    let codes = Code::ERRORS
+        .into_iter()
+        .chain(Lint::ALL.into_iter().map(Code::Lint));
+    let mut missing = Vec::new();
+    for code in codes {
+        let name = code.name();
+        if !doc.contains(&format!("#### `{name}`\n")) {
+            missing.push(format!("no `#### `{name}`` section"));
+        }
+        if !shown.contains(name) {
+            missing.push(format!("no `expect={name}` example"));
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "docs/language.md: {}",
+        missing.join("; ")
+    );
+}
+
+#[test]
+fn the_readme_gives_the_two_commands() {
+    let readme = std::fs::read_to_string("README.md").unwrap();
+    let commands: Vec<&str> = readme
+        .lines()
+        .map(|l| l.split('#').next().unwrap_or("").trim())
+        .filter(|l| l.starts_with("cargo "))
+        .collect();
+    for want in [
+        "cargo run --release -- build plans/submarine",
+        "cargo test --workspace",
+    ] {
+        assert!(
+            commands.contains(&want),
+            "README.md should give `{want}`; its cargo commands: {commands:?}"
+        );
+    }
+    assert!(
+        readme.contains("docs/ahead.svg"),
+        "README.md shows the graph"
+    );
+    assert!(
+        readme.contains("docs/language.md"),
+        "README.md links the reference"
+    );
+}
+
+/// SVG text without what depends on the Graphviz build (its version comment).
+fn normalise_svg(svg: &str) -> String {
+    let mut svg = svg.replace("\r\n", "\n");
+    if let Some(start) = svg.find("<!-- Generated by graphviz") {
+        if let Some(len) = svg[start..].find("-->") {
+            svg.replace_range(start..start + len + 3, "");
+        }
+    }
+    svg
+}
+
+#[test]
+fn the_readme_state_graph_is_up_to_date() {
+    if Command::new("dot").arg("-V").output().is_err() {
+        if std::env::var_os("CI").is_some() {
+            panic!("Graphviz `dot` is needed to check docs/ahead.svg (CI installs it)");
+        }
+        eprintln!("note: Graphviz `dot` not found; docs/ahead.svg not checked");
+        return;
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_rcsc"))
+        .args([
+            "graph",
+            "plans/submarine",
+            "--plan",
+            "PR.AHEAD",
+            "--format",
+            "svg",
+        ])
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("rcsc runs");
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let fresh = String::from_utf8(out.stdout).expect("SVG is UTF-8");
+    let path = "docs/ahead.svg";
+    if std::env::var_os("UPDATE_DOCS").is_some() {
+        std::fs::write(path, &fresh).unwrap();
+        return;
+    }
+    let committed = std::fs::read_to_string(path).unwrap_or_default();
+    assert!(
+        normalise_svg(&committed) == normalise_svg(&fresh),
+        "{path} is stale: regenerate it with `UPDATE_DOCS=1 cargo test --test docs` \
+         (or `rcsc graph plans/submarine --plan PR.AHEAD --format svg -o {path}`)"
+    );
+}

@@ -28,6 +28,7 @@ pub mod parser;
 pub mod pretty;
 pub mod render;
 pub mod source;
+pub mod yaml;
 
 pub use diagnostic::{Code, Diagnostic, Diagnostics, Severity};
 pub use load::{load_folder, load_paths, LoadError, PlanSet};

@@ -8,8 +8,8 @@ use crate::diagnostic::{Code, Diagnostic};
 use crate::ir::Limits;
 use crate::lint::{Level, Lint, LintOverride};
 use crate::source::{FileId, SourceFile, Span};
+use crate::yaml::{self, Spanned};
 use serde::Deserialize;
-use serde_saphyr::Spanned;
 use std::collections::BTreeMap;
 
 /// The default executive period when the manifest gives no schedule.
@@ -62,46 +62,18 @@ struct RawCpu {
 
 /// Parse a manifest. Every problem is a `manifest` diagnostic in `file`.
 pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>> {
-    let span_of = |line: u64, column: u64, byte: Option<u64>, len: Option<u64>| -> Span {
-        let start = match byte {
-            Some(b) => (b as usize).min(file.text.len()),
-            None => offset_of(file, line, column),
-        };
-        let end = (start + len.unwrap_or(0) as usize).min(file.text.len());
-        Span::new(id, start, end)
-    };
-    let spanned = |loc: &serde_saphyr::Location| -> Span {
-        let s = loc.span();
-        let sp = span_of(loc.line(), loc.column(), s.byte_offset(), s.byte_len());
-        if sp.start == sp.end {
-            // Point at the rest of the line's token.
-            let rest = &file.text[sp.start as usize..];
-            let len = rest.find(['\n', '\r', ',', ']', '}']).unwrap_or(rest.len());
-            Span::new(
-                id,
-                sp.start as usize,
-                sp.start as usize + rest[..len].trim_end().len(),
-            )
-        } else {
-            sp
-        }
-    };
-    if file
-        .text
-        .lines()
-        .all(|l| l.trim().is_empty() || l.trim_start().starts_with('#'))
-    {
+    let spanned = |loc: &yaml::Location| -> Span { yaml::span(id, file, loc) };
+    if yaml::is_empty(&file.text) {
         return Ok(Manifest::default());
     }
-    let options = serde_saphyr::options! { with_snippet: false };
-    let raw: Raw = match serde_saphyr::from_str_with_options(&file.text, options) {
+    let raw: Raw = match yaml::from_str(&file.text) {
         Ok(raw) => raw,
         Err(e) => {
-            let span = match e.location() {
-                Some(loc) => spanned(&loc),
+            let span = match &e.location {
+                Some(loc) => spanned(loc),
                 None => Span::new(id, 0, 0),
             };
-            let (message, label) = describe_yaml_error(&first_line(&e.to_string()));
+            let (message, label) = describe_yaml_error(&e.message);
             let d = Diagnostic::error(
                 Code::Manifest,
                 format!("invalid `rcs.yaml`: {message}"),
@@ -232,7 +204,7 @@ pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>>
 /// Any serialisable value as YAML (`rcsc ir`), through the same library
 /// that reads manifests, so the project has one YAML dependency.
 pub fn to_yaml<T: serde::Serialize>(value: &T) -> Result<String, serde_saphyr::SerializeError> {
-    serde_saphyr::to_string(value)
+    yaml::to_string(value)
 }
 
 /// `30ms`, `1.5s`, `500us`/`500µs`, `100ns`, in nanoseconds.
@@ -289,22 +261,4 @@ fn describe_yaml_error(message: &str) -> (String, &'static str) {
         return ("expected a whole number".to_string(), "not a whole number");
     }
     (message.to_string(), "here")
-}
-
-fn first_line(s: &str) -> String {
-    s.lines().next().unwrap_or("").trim().to_string()
-}
-
-fn offset_of(file: &SourceFile, line: u64, column: u64) -> usize {
-    let starts = file.line_starts();
-    let Some(&start) = starts.get((line as usize).saturating_sub(1)) else {
-        return file.text.len();
-    };
-    let rest = &file.text[start..];
-    start
-        + rest
-            .char_indices()
-            .nth((column as usize).saturating_sub(1))
-            .map(|(i, _)| i)
-            .unwrap_or(rest.len())
 }

@@ -227,12 +227,7 @@ fn bookkeeping<'a>(exec: &'a Executive, name: &str) -> Option<&'a Bookkeeping> {
 /// One table row: the controllers after this cycle, the rows PR fired since
 /// the last table row, and the world the controllers read in this cycle.
 fn print_row(cycle: u64, exec: &Executive, pr_rows: &[RowId], drive: TurbineDrive, read: Plant) {
-    let rows = if pr_rows.is_empty() {
-        "-".to_string()
-    } else {
-        let rows: Vec<String> = pr_rows.iter().map(|r| format!("E{r}")).collect();
-        rows.join(" ")
-    };
+    let rows = rows_fired(pr_rows);
     println!(
         "{cycle:>5} | {:<20} | {:<18} | {rows:<7} | {:<18} | {:>7.1} | {:>8.1} | {:>7.3}",
         cell(bookkeeping(exec, sm::NAME), sm_names, sm_status),
@@ -242,6 +237,28 @@ fn print_row(cycle: u64, exec: &Executive, pr_rows: &[RowId], drive: TurbineDriv
         read.rpm,
         read.speed,
     );
+}
+
+/// Rows in order, runs of one row counted: `E2×8 E3`; `-` for none.
+fn rows_fired(rows: &[RowId]) -> String {
+    let mut runs: Vec<(RowId, usize)> = Vec::new();
+    for &row in rows {
+        match runs.last_mut() {
+            Some((last, n)) if *last == row => *n += 1,
+            _ => runs.push((row, 1)),
+        }
+    }
+    if runs.is_empty() {
+        return "-".into();
+    }
+    let runs: Vec<String> = runs
+        .iter()
+        .map(|&(row, n)| match n {
+            1 => format!("E{row}"),
+            n => format!("E{row}×{n}"),
+        })
+        .collect();
+    runs.join(" ")
 }
 
 fn print_header() {
@@ -511,6 +528,13 @@ mod tests {
         assert_eq!(speed_error(14.95, 15.0, 0.1), SpeedError::At);
         assert_eq!(speed_error(15.05, 15.0, 0.1), SpeedError::At);
         assert_eq!(speed_error(15.15, 15.0, 0.1), SpeedError::Above);
+    }
+
+    #[test]
+    fn rows_fired_counts_runs() {
+        assert_eq!(rows_fired(&[]), "-");
+        assert_eq!(rows_fired(&[0]), "E0");
+        assert_eq!(rows_fired(&[2, 2, 2, 3, 3]), "E2×3 E3×2");
     }
 
     #[test]

@@ -27,6 +27,7 @@ pub mod manifest;
 pub mod parser;
 pub mod pretty;
 pub mod render;
+pub mod scenario;
 pub mod source;
 pub mod yaml;
 

@@ -1,0 +1,839 @@
+//! Scenarios (`*.scenario.yaml`, TOOLING.md): a controller driven alone
+//! through written steps — the scenario plays its supervisor, its
+//! subordinates, its `reads` buffers and its hooks — with expectations
+//! checked after each step. This module reads a scenario (through
+//! [`crate::yaml`]), resolves every name against the IR, and runs it on
+//! the reference interpreter.
+
+use crate::interp::{wrap, HookData, Hooks, Interpreter, Value};
+use crate::ir::*;
+use crate::source::SourceFile;
+use crate::yaml::{self, Spanned};
+use rcs_runtime::{Status, StatusBuffer};
+use serde::Deserialize;
+use serde_json::Value as Json;
+use std::collections::BTreeMap;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawScenario {
+    name: Option<String>,
+    controller: Spanned<String>,
+    initial: Option<RawSettings>,
+    steps: Vec<Spanned<RawStep>>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawSettings {
+    reads: Option<Json>,
+    hooks: Option<Json>,
+    subordinates: Option<Json>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawStep {
+    command: Option<Json>,
+    reads: Option<Json>,
+    hooks: Option<Json>,
+    subordinates: Option<Json>,
+    cycles: Option<u32>,
+    expect: Option<RawExpect>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawExpect {
+    fired: Option<Json>,
+    state: Option<String>,
+    status: Option<String>,
+    error: Option<String>,
+    sent: Option<Json>,
+    vars: Option<Json>,
+    writes: Option<Json>,
+}
+
+/// A problem with a scenario file (not a failed expectation): where and what.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScenarioError {
+    pub line: usize,
+    pub message: String,
+}
+
+/// How a subordinate's status buffer looks to the controller.
+#[derive(Clone, Debug, PartialEq)]
+struct SubSetting {
+    status: u16,
+    echo: Echo,
+    silent: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Echo {
+    Current,
+    Previous,
+    Literal(u32),
+}
+
+/// What a step expects after its last cycle.
+#[derive(Clone, Debug, Default)]
+struct Expect {
+    /// `Some(None)`: no row fired.
+    fired: Option<Option<String>>,
+    state: Option<String>,
+    status: Option<u16>,
+    /// `Some(None)`: no error.
+    error: Option<Option<u16>>,
+    sent: Option<Vec<(CtrlId, CommandId, Vec<Value>)>>,
+    vars: Vec<(usize, Value)>,
+    /// Subset match: only the fields named are compared.
+    writes: Vec<(usize, Json)>,
+}
+
+struct Step {
+    line: usize,
+    command: Option<(CommandId, Vec<Value>)>,
+    reads: Vec<(usize, Json)>,
+    hooks: Vec<(HookId, Value)>,
+    subs: Vec<(usize, SubSetting)>,
+    cycles: u32,
+    expect: Expect,
+}
+
+/// A scenario resolved against a controller of the IR.
+pub struct Scenario {
+    pub name: String,
+    pub controller: CtrlId,
+    initial: Step,
+    steps: Vec<Step>,
+}
+
+fn err(line: usize, message: impl Into<String>) -> ScenarioError {
+    ScenarioError {
+        line,
+        message: message.into(),
+    }
+}
+
+/// Read and resolve a scenario. `stem` names it when it has no `name:`.
+pub fn parse(ir: &Ir, file: &SourceFile, stem: &str) -> Result<Scenario, ScenarioError> {
+    let raw: RawScenario = yaml::from_str(&file.text)
+        .map_err(|e| err(e.location.map_or(1, |l| l.line() as usize), e.message))?;
+    let cline = raw.controller.referenced.line() as usize;
+    let ctrl = ir
+        .controller_by_name(&raw.controller.value)
+        .ok_or_else(|| {
+            err(
+                cline,
+                format!("unknown controller `{}`", raw.controller.value),
+            )
+        })?;
+    let r = Resolver {
+        ir,
+        c: ir.controller(ctrl),
+    };
+    let initial = match raw.initial {
+        Some(s) => r.step(cline, None, s.reads, s.hooks, s.subordinates, None, None)?,
+        None => r.step(cline, None, None, None, None, None, None)?,
+    };
+    let mut steps = Vec::new();
+    for s in raw.steps {
+        let line = s.referenced.line() as usize;
+        let v = s.value;
+        steps.push(r.step(
+            line,
+            v.command,
+            v.reads,
+            v.hooks,
+            v.subordinates,
+            v.cycles,
+            v.expect,
+        )?);
+    }
+    Ok(Scenario {
+        name: raw.name.unwrap_or_else(|| stem.to_string()),
+        controller: ctrl,
+        initial,
+        steps,
+    })
+}
+
+struct Resolver<'a> {
+    ir: &'a Ir,
+    c: &'a Controller,
+}
+
+impl Resolver<'_> {
+    #[allow(clippy::too_many_arguments)]
+    fn step(
+        &self,
+        line: usize,
+        command: Option<Json>,
+        reads: Option<Json>,
+        hooks: Option<Json>,
+        subs: Option<Json>,
+        cycles: Option<u32>,
+        expect: Option<RawExpect>,
+    ) -> Result<Step, ScenarioError> {
+        let command = command.map(|c| self.command(line, &c)).transpose()?;
+        let mut read_list = Vec::new();
+        for (name, v) in object(line, reads.as_ref(), "reads")? {
+            let i = self
+                .c
+                .reads
+                .iter()
+                .position(|b| self.ir.buffers[b.index()].name == *name)
+                .ok_or_else(|| err(line, format!("`{}` reads no buffer `{name}`", self.c.name)))?;
+            // Check the shape now; values merge into the current buffer when run.
+            let ty = Type::Buffer(self.ir.buffers[self.c.reads[i].index()].ty);
+            merge(self.ir, line, &Value::zero(self.ir, &ty), &ty, v, name)?;
+            read_list.push((i, v.clone()));
+        }
+        let mut hook_list = Vec::new();
+        for (name, v) in object(line, hooks.as_ref(), "hooks")? {
+            let h = self
+                .c
+                .hooks
+                .iter()
+                .position(|h| h.name == *name)
+                .ok_or_else(|| err(line, format!("`{}` has no hook `{name}`", self.c.name)))?;
+            let value = value(self.ir, line, &self.c.hooks[h].ret, v, name)?;
+            hook_list.push((HookId(h as u32), value));
+        }
+        let mut sub_list = Vec::new();
+        for (name, v) in object(line, subs.as_ref(), "subordinates")? {
+            let i = self
+                .c
+                .subordinates
+                .iter()
+                .position(|s| self.ir.controller(*s).name == *name)
+                .ok_or_else(|| {
+                    err(
+                        line,
+                        format!("`{name}` is not a subordinate of `{}`", self.c.name),
+                    )
+                })?;
+            let sub = self.ir.controller(self.c.subordinates[i]);
+            sub_list.push((i, self.sub_setting(line, sub, v)?));
+        }
+        let expect = match expect {
+            Some(e) => self.expect(line, e)?,
+            None => Expect::default(),
+        };
+        Ok(Step {
+            line,
+            command,
+            reads: read_list,
+            hooks: hook_list,
+            subs: sub_list,
+            cycles: cycles.unwrap_or(1).max(1),
+            expect,
+        })
+    }
+
+    /// `INIT` or `{ AHEAD: { speed: 10.0 } }`.
+    fn command(&self, line: usize, v: &Json) -> Result<(CommandId, Vec<Value>), ScenarioError> {
+        let (verb, args) = match v {
+            Json::String(s) => (s.as_str(), None),
+            Json::Object(m) if m.len() == 1 => {
+                let (k, a) = m.iter().next().expect("one entry");
+                (k.as_str(), Some(a))
+            }
+            _ => {
+                return Err(err(
+                    line,
+                    "`command` is a verb (`INIT`) or `{ VERB: { param: value } }`",
+                ))
+            }
+        };
+        verb_args(self.ir, self.c, line, verb, args)
+    }
+
+    fn sub_setting(
+        &self,
+        line: usize,
+        sub: &Controller,
+        v: &Json,
+    ) -> Result<SubSetting, ScenarioError> {
+        let status_of = |name: &str| {
+            sub.statuses
+                .iter()
+                .position(|s| s.name == name)
+                .map(|i| i as u16)
+                .ok_or_else(|| err(line, format!("`{}` has no status `{name}`", sub.name)))
+        };
+        match v {
+            Json::String(s) => Ok(SubSetting {
+                status: status_of(s)?,
+                echo: Echo::Current,
+                silent: false,
+            }),
+            Json::Object(m) => {
+                let mut s = SubSetting {
+                    status: 0,
+                    echo: Echo::Current,
+                    silent: false,
+                };
+                for (k, x) in m {
+                    match (k.as_str(), x) {
+                        ("status", Json::String(n)) => s.status = status_of(n)?,
+                        ("echo", Json::String(e)) if e == "current" => s.echo = Echo::Current,
+                        ("echo", Json::String(e)) if e == "previous" => s.echo = Echo::Previous,
+                        ("echo", Json::Number(n)) => {
+                            s.echo = Echo::Literal(n.as_u64().and_then(|n| u32::try_from(n).ok()).ok_or_else(|| err(line, "`echo` is a serial (0 to 4294967295)"))?)
+                        }
+                        ("silent", Json::Bool(b)) => s.silent = *b,
+                        (k, _) => return Err(err(line, format!("bad subordinate setting `{k}`: expected `status: NAME`, `echo: current|previous|N`, `silent: true|false`"))),
+                    }
+                }
+                Ok(s)
+            }
+            _ => Err(err(
+                line,
+                format!(
+                    "subordinate `{}`: expected a status name or `{{ status, echo, silent }}`",
+                    sub.name
+                ),
+            )),
+        }
+    }
+
+    fn expect(&self, line: usize, e: RawExpect) -> Result<Expect, ScenarioError> {
+        let mut out = Expect::default();
+        if let Some(f) = e.fired {
+            let name = match &f {
+                Json::String(s) => s.clone(),
+                Json::Number(n) => n.to_string(),
+                _ => {
+                    return Err(err(
+                        line,
+                        "`fired` is a row name (`E3`, `*0`, `otherwise`, `#2`) or `none`",
+                    ))
+                }
+            };
+            if name == "none" {
+                out.fired = Some(None);
+            } else {
+                let known = self
+                    .c
+                    .plans
+                    .iter()
+                    .flat_map(|p| &p.rows)
+                    .any(|r| row_names(r).contains(&name));
+                if !known {
+                    return Err(err(
+                        line,
+                        format!("no row of `{}` is called `{name}`", self.c.name),
+                    ));
+                }
+                out.fired = Some(Some(name));
+            }
+        }
+        if let Some(s) = e.state {
+            let known = s == "S0"
+                || self
+                    .c
+                    .plans
+                    .iter()
+                    .flat_map(|p| &p.states)
+                    .any(|x| x.name == s);
+            if !known {
+                return Err(err(
+                    line,
+                    format!("no plan of `{}` has a state `{s}`", self.c.name),
+                ));
+            }
+            out.state = Some(s);
+        }
+        if let Some(s) = e.status {
+            let i = self
+                .c
+                .statuses
+                .iter()
+                .position(|x| x.name == s)
+                .ok_or_else(|| err(line, format!("`{}` has no status `{s}`", self.c.name)))?;
+            out.status = Some(i as u16);
+        }
+        if let Some(x) = e.error {
+            out.error = Some(match x.as_str() {
+                "none" => None,
+                "UNKNOWN_COMMAND" => Some(rcs_runtime::ErrorCode::UNKNOWN_COMMAND.0),
+                name => {
+                    let i = self
+                        .c
+                        .errors
+                        .iter()
+                        .position(|x| x.name == name)
+                        .ok_or_else(|| {
+                            err(
+                                line,
+                                format!("`{}` has no error code `{name}`", self.c.name),
+                            )
+                        })?;
+                    Some(rcs_runtime::ErrorCode::custom(i as u16).0)
+                }
+            });
+        }
+        if let Some(sent) = e.sent {
+            let mut list = Vec::new();
+            for (name, v) in object(line, Some(&sent), "sent")? {
+                let si = self
+                    .c
+                    .subordinates
+                    .iter()
+                    .position(|s| self.ir.controller(*s).name == *name)
+                    .ok_or_else(|| {
+                        err(
+                            line,
+                            format!("`{name}` is not a subordinate of `{}`", self.c.name),
+                        )
+                    })?;
+                let sub = self.ir.controller(self.c.subordinates[si]);
+                let (verb, args) = match v {
+                    Json::String(s) => (s.as_str(), None),
+                    Json::Object(m) if m.len() == 1 => {
+                        let (k, a) = m.iter().next().expect("one entry");
+                        (k.as_str(), Some(a))
+                    }
+                    _ => {
+                        return Err(err(
+                            line,
+                            format!("`sent.{name}` is a verb or `{{ VERB: {{ param: value }} }}`"),
+                        ))
+                    }
+                };
+                let (cmd, vals) = verb_args(self.ir, sub, line, verb, args)?;
+                list.push((self.c.subordinates[si], cmd, vals));
+            }
+            out.sent = Some(list);
+        }
+        for (name, v) in object(line, e.vars.as_ref(), "vars")? {
+            let i = self
+                .c
+                .vars
+                .iter()
+                .position(|x| x.name == *name)
+                .ok_or_else(|| err(line, format!("`{}` has no var `{name}`", self.c.name)))?;
+            out.vars
+                .push((i, value(self.ir, line, &self.c.vars[i].ty, v, name)?));
+        }
+        for (name, v) in object(line, e.writes.as_ref(), "writes")? {
+            let i = self
+                .c
+                .writes
+                .iter()
+                .position(|b| self.ir.buffers[b.index()].name == *name)
+                .ok_or_else(|| err(line, format!("`{}` writes no buffer `{name}`", self.c.name)))?;
+            let ty = Type::Buffer(self.ir.buffers[self.c.writes[i].index()].ty);
+            merge(self.ir, line, &Value::zero(self.ir, &ty), &ty, v, name)?;
+            out.writes.push((i, v.clone()));
+        }
+        Ok(out)
+    }
+}
+
+/// Every name a row answers to in `fired`: `EN`, `*N`, `otherwise`, `#N`.
+fn row_names(r: &Row) -> Vec<String> {
+    let mut names = vec![format!("#{}", r.position)];
+    if let Some(n) = r.label {
+        names.push(format!("E{n}"));
+    }
+    if r.is_dont_care() {
+        names.push(format!("*{}", r.position));
+    }
+    if r.is_otherwise() {
+        names.push("otherwise".to_string());
+    }
+    names
+}
+
+fn object<'j>(
+    line: usize,
+    v: Option<&'j Json>,
+    what: &str,
+) -> Result<Vec<(&'j String, &'j Json)>, ScenarioError> {
+    match v {
+        None | Some(Json::Null) => Ok(Vec::new()),
+        Some(Json::Object(m)) => Ok(m.iter().collect()),
+        Some(_) => Err(err(
+            line,
+            format!("`{what}` is a mapping of names to values"),
+        )),
+    }
+}
+
+fn verb_args(
+    ir: &Ir,
+    c: &Controller,
+    line: usize,
+    verb: &str,
+    args: Option<&Json>,
+) -> Result<(CommandId, Vec<Value>), ScenarioError> {
+    let ci = c
+        .commands
+        .iter()
+        .position(|k| k.name == verb)
+        .ok_or_else(|| err(line, format!("`{}` has no command `{verb}`", c.name)))?;
+    let cmd = &c.commands[ci];
+    let given: BTreeMap<&String, &Json> = object(line, args, "parameters")?.into_iter().collect();
+    for k in given.keys() {
+        if !cmd.params.iter().any(|p| p.name == **k) {
+            return Err(err(
+                line,
+                format!("command `{verb}` of `{}` has no parameter `{k}`", c.name),
+            ));
+        }
+    }
+    let mut vals = Vec::new();
+    for p in &cmd.params {
+        let v = given.get(&p.name).ok_or_else(|| {
+            err(
+                line,
+                format!("command `{verb}` needs parameter `{}`", p.name),
+            )
+        })?;
+        vals.push(value(ir, line, &p.ty, v, &p.name)?);
+    }
+    Ok((CommandId(ci as u32), vals))
+}
+
+/// A YAML value as a run-time value of type `t`.
+fn value(ir: &Ir, line: usize, t: &Type, v: &Json, what: &str) -> Result<Value, ScenarioError> {
+    let bad = || {
+        err(
+            line,
+            format!(
+                "`{what}`: expected {}, found `{v}`",
+                crate::type_name(ir, t)
+            ),
+        )
+    };
+    Ok(match (t, v) {
+        (Type::Bool, Json::Bool(b)) => Value::Bool(*b),
+        (Type::Int(it), Json::Number(n)) => {
+            let i = n
+                .as_i64()
+                .map(i128::from)
+                .or_else(|| n.as_u64().map(i128::from))
+                .ok_or_else(bad)?;
+            let (lo, hi) = it.range();
+            if i < lo || i > hi {
+                return Err(bad());
+            }
+            Value::Int(wrap(i, *it))
+        }
+        (Type::Float(ft), Json::Number(n)) => {
+            let f = n.as_f64().ok_or_else(bad)?;
+            Value::Float(if *ft == FloatTy::F32 {
+                f as f32 as f64
+            } else {
+                f
+            })
+        }
+        (Type::Enum(e), Json::String(s)) => Value::Enum(
+            ir.enums[e.index()]
+                .variants
+                .iter()
+                .position(|x| x.name == *s)
+                .ok_or_else(bad)? as u32,
+        ),
+        (Type::Buffer(_), Json::Object(_)) => merge(ir, line, &Value::zero(ir, t), t, v, what)?,
+        (Type::Array(elem, n), Json::Array(items)) if items.len() == *n as usize => Value::Array(
+            items
+                .iter()
+                .map(|x| value(ir, line, elem, x, what))
+                .collect::<Result<_, _>>()?,
+        ),
+        _ => return Err(bad()),
+    })
+}
+
+/// Deep-merge a YAML mapping into a buffer value (fields not named keep theirs).
+fn merge(
+    ir: &Ir,
+    line: usize,
+    base: &Value,
+    t: &Type,
+    v: &Json,
+    what: &str,
+) -> Result<Value, ScenarioError> {
+    match (t, base, v) {
+        (Type::Buffer(b), Value::Buffer(fields), Json::Object(m)) => {
+            let bt = &ir.buffer_types[b.index()];
+            let mut out = fields.clone();
+            for (k, x) in m {
+                let fi = bt.fields.iter().position(|f| f.name == *k).ok_or_else(|| {
+                    err(
+                        line,
+                        format!("buffer type `{}` has no field `{k}`", bt.name),
+                    )
+                })?;
+                out[fi] = merge(ir, line, &fields[fi], &bt.fields[fi].ty, x, k)?;
+            }
+            Ok(Value::Buffer(out))
+        }
+        _ => value(ir, line, t, v, what),
+    }
+}
+
+/// One scenario's outcome.
+#[derive(Debug)]
+pub struct Outcome {
+    pub name: String,
+    /// `None`: passed. Otherwise the line of the failing step and the report.
+    pub failure: Option<(usize, String)>,
+    /// Rows fired, by name, cycle by cycle (`-` for none).
+    pub fired: Vec<String>,
+}
+
+struct ScenarioHooks<'a> {
+    ir: &'a Ir,
+    values: BTreeMap<u32, Value>,
+}
+
+impl Hooks for ScenarioHooks<'_> {
+    /// The value the scenario gives the hook, or its type's zero.
+    fn call(&mut self, data: &HookData, hook: HookId, _: &[Value]) -> Value {
+        self.values
+            .get(&hook.0)
+            .cloned()
+            .unwrap_or_else(|| Value::zero(self.ir, &data.ctrl.hooks[hook.index()].ret))
+    }
+}
+
+fn float_eq(a: &Value, b: &Value) -> bool {
+    match (a, b) {
+        (Value::Float(x), Value::Float(y)) => (x - y).abs() <= 1e-9,
+        (Value::Buffer(xs), Value::Buffer(ys)) | (Value::Array(xs), Value::Array(ys)) => {
+            xs.len() == ys.len() && xs.iter().zip(ys).all(|(x, y)| float_eq(x, y))
+        }
+        _ => a == b,
+    }
+}
+
+/// Run a scenario on the interpreter.
+pub fn run(ir: &Ir, s: &Scenario) -> Outcome {
+    let c = ir.controller(s.controller);
+    let mut interp = Interpreter::new(ir, s.controller);
+    let mut hooks = ScenarioHooks {
+        ir,
+        values: BTreeMap::new(),
+    };
+    let mut subs: Vec<SubSetting> = vec![
+        SubSetting {
+            status: 0,
+            echo: Echo::Literal(0),
+            silent: false
+        };
+        c.subordinates.len()
+    ];
+    let mut fired = Vec::new();
+    for (k, step) in std::iter::once(&s.initial).chain(&s.steps).enumerate() {
+        if let Some((cmd, args)) = &step.command {
+            interp.command(*cmd, args.clone());
+        }
+        for (i, v) in &step.reads {
+            let ty = Type::Buffer(ir.buffers[c.reads[*i].index()].ty);
+            if let Ok(merged) = merge(ir, step.line, &interp.reads()[*i], &ty, v, "reads") {
+                interp.set_read(*i, merged);
+            }
+        }
+        for (h, v) in &step.hooks {
+            hooks.values.insert(h.0, v.clone());
+        }
+        // `echo: current` is the serial last sent as of the start of the step.
+        let mut echoes: Vec<u32> = subs
+            .iter()
+            .enumerate()
+            .map(|(i, s)| echo_of(s.echo, interp.last_sent(i)))
+            .collect();
+        for (i, setting) in &step.subs {
+            subs[*i] = setting.clone();
+            echoes[*i] = echo_of(setting.echo, interp.last_sent(*i));
+        }
+        if k == 0 {
+            continue; // `initial` sets the scene; it runs no cycle.
+        }
+        let mut last = None;
+        for _ in 0..step.cycles {
+            for (i, sub) in subs.iter().enumerate() {
+                if !sub.silent {
+                    interp.write_sub_status(
+                        i,
+                        StatusBuffer {
+                            echo_serial: echoes[i],
+                            status: Status(sub.status),
+                            ..StatusBuffer::default()
+                        },
+                    );
+                }
+            }
+            let rec = interp.cycle(&mut hooks);
+            fired.push(
+                rec.fired
+                    .map(|r| fired_name(c, &rec, r))
+                    .unwrap_or_else(|| "-".to_string()),
+            );
+            last = Some(rec);
+        }
+        let rec = last.expect("a step runs at least one cycle");
+        if let Some(report) = check(ir, c, &step.expect, &rec) {
+            return Outcome {
+                name: s.name.clone(),
+                failure: Some((step.line, report)),
+                fired,
+            };
+        }
+    }
+    Outcome {
+        name: s.name.clone(),
+        failure: None,
+        fired,
+    }
+}
+
+fn echo_of(e: Echo, last_sent: u32) -> u32 {
+    match e {
+        Echo::Current => last_sent,
+        Echo::Previous => last_sent.wrapping_sub(1),
+        Echo::Literal(n) => n,
+    }
+}
+
+fn plan_of<'c>(c: &'c Controller, rec: &crate::interp::CycleRecord) -> Option<&'c Plan> {
+    rec.verb
+        .and_then(|v| c.commands[v.index()].plan)
+        .map(|p| &c.plans[p.index()])
+}
+
+fn fired_name(c: &Controller, rec: &crate::interp::CycleRecord, row: RowId) -> String {
+    plan_of(c, rec)
+        .map(|p| p.rows[row.index()].display_name())
+        .unwrap_or_else(|| format!("#{}", row.0))
+}
+
+/// Compare a step's expectations with the last cycle; `None` when all hold.
+fn check(ir: &Ir, c: &Controller, e: &Expect, rec: &crate::interp::CycleRecord) -> Option<String> {
+    let mut problems = Vec::new();
+    let plan = plan_of(c, rec);
+    if let Some(want) = &e.fired {
+        let got = rec.fired.and_then(|r| plan.map(|p| &p.rows[r.index()]));
+        let ok = match (want, got) {
+            (None, None) => true,
+            (Some(name), Some(row)) => row_names(row).contains(name),
+            _ => false,
+        };
+        if !ok {
+            let got = got
+                .map(|r| r.display_name())
+                .unwrap_or_else(|| "none".into());
+            problems.push(format!(
+                "fired: expected {}, got {got}",
+                want.clone().unwrap_or_else(|| "none".into())
+            ));
+        }
+    }
+    if let Some(want) = &e.state {
+        let got = plan
+            .map(|p| p.states[rec.state.index()].name.clone())
+            .unwrap_or_else(|| "S0".into());
+        if *want != got {
+            problems.push(format!("state: expected {want}, got {got}"));
+        }
+    }
+    if let Some(want) = e.status {
+        if u32::from(want) != rec.status.0 {
+            let name = |i: u32| {
+                c.statuses
+                    .get(i as usize)
+                    .map(|s| s.name.clone())
+                    .unwrap_or_else(|| i.to_string())
+            };
+            problems.push(format!(
+                "status: expected {}, got {}",
+                name(u32::from(want)),
+                name(rec.status.0)
+            ));
+        }
+    }
+    if let Some(want) = &e.error {
+        if *want != rec.error {
+            let name = |x: Option<u16>| match x {
+                None => "none".to_string(),
+                Some(1) => "UNKNOWN_COMMAND".to_string(),
+                Some(n) => c
+                    .errors
+                    .get(usize::from(n) - 2)
+                    .map(|e| e.name.clone())
+                    .unwrap_or_else(|| n.to_string()),
+            };
+            problems.push(format!(
+                "error: expected {}, got {}",
+                name(*want),
+                name(rec.error)
+            ));
+        }
+    }
+    if let Some(want) = &e.sent {
+        let got: Vec<(CtrlId, CommandId, Vec<Value>)> = rec
+            .sent
+            .iter()
+            .map(|s| (s.sub, s.command, s.args.clone()))
+            .collect();
+        let same = want.len() == got.len()
+            && want.iter().all(|w| {
+                got.iter().any(|g| {
+                    g.0 == w.0
+                        && g.1 == w.1
+                        && g.2.len() == w.2.len()
+                        && g.2.iter().zip(&w.2).all(|(a, b)| float_eq(a, b))
+                })
+            });
+        if !same {
+            let show = |l: &[(CtrlId, CommandId, Vec<Value>)]| {
+                if l.is_empty() {
+                    return "{}".to_string();
+                }
+                l.iter()
+                    .map(|(s, k, a)| {
+                        let sub = ir.controller(*s);
+                        format!(
+                            "{} <- {}{}",
+                            sub.name,
+                            sub.commands[k.index()].name,
+                            if a.is_empty() {
+                                String::new()
+                            } else {
+                                format!("{a:?}")
+                            }
+                        )
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            problems.push(format!("sent: expected {}, got {}", show(want), show(&got)));
+        }
+    }
+    for (i, v) in &e.vars {
+        if !float_eq(v, &rec.vars[*i]) {
+            problems.push(format!(
+                "vars.{}: expected {v:?}, got {:?}",
+                c.vars[*i].name, rec.vars[*i]
+            ));
+        }
+    }
+    for (i, v) in &e.writes {
+        // Merge the expected fields into the actual value: equal iff they match.
+        let ty = Type::Buffer(ir.buffers[c.writes[*i].index()].ty);
+        let name = &ir.buffers[c.writes[*i].index()].name;
+        match merge(ir, 0, &rec.writes[*i], &ty, v, name) {
+            Ok(expected) if float_eq(&expected, &rec.writes[*i]) => {}
+            _ => problems.push(format!(
+                "writes.{name}: expected {v}, got {:?}",
+                rec.writes[*i]
+            )),
+        }
+    }
+    (!problems.is_empty()).then(|| problems.join("; "))
+}

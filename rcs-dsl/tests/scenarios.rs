@@ -1,0 +1,117 @@
+//! Scenarios on the reference interpreter: every scenario under
+//! `plans/*/scenarios/` passes, a wrong expectation fails naming its line,
+//! expected against actual, and the rows fired so far, and a scenario that
+//! names something the plans do not have is refused with its line.
+
+use rcs_dsl::scenario;
+use rcs_dsl::source::SourceFile;
+use rcs_dsl::{check, load_folder, Options};
+use std::path::Path;
+
+fn submarine() -> rcs_dsl::ir::Ir {
+    let set = load_folder(Path::new("../plans/submarine")).expect("plans");
+    check(&set, &Options::default()).ir.expect("clean")
+}
+
+fn scenario_file(path: &str) -> SourceFile {
+    SourceFile::new(path, std::fs::read_to_string(path).expect(path))
+}
+
+#[test]
+fn every_plan_scenario_passes() {
+    let mut ran = 0;
+    for set in ["../plans/submarine", "../plans/figure13"] {
+        let loaded = load_folder(Path::new(set)).expect("plans");
+        let ir = check(&loaded, &Options::default()).ir.expect("clean");
+        let dir = Path::new(set).join("scenarios");
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        let mut paths: Vec<_> = entries.map(|e| e.unwrap().path()).collect();
+        paths.sort();
+        for p in paths {
+            let file = scenario_file(p.to_str().unwrap());
+            let s = scenario::parse(&ir, &file, "s")
+                .unwrap_or_else(|e| panic!("{}:{}: {}", p.display(), e.line, e.message));
+            let out = scenario::run(&ir, &s);
+            assert!(
+                out.failure.is_none(),
+                "{}: {:?}; fired {:?}",
+                p.display(),
+                out.failure,
+                out.fired
+            );
+            ran += 1;
+        }
+    }
+    assert!(ran >= 1, "no scenario found");
+}
+
+#[test]
+fn a_wrong_expectation_fails_with_its_line_and_the_rows_so_far() {
+    let ir = submarine();
+    let file = scenario_file("../tests/data/scenarios/wrong_expectation.scenario.yaml");
+    let s = scenario::parse(&ir, &file, "wrong_expectation").expect("well-formed");
+    assert_eq!(s.name, "wrong_expectation");
+    let out = scenario::run(&ir, &s);
+    let (line, report) = out.failure.expect("fails");
+    assert_eq!(line, 10, "the failing step's line");
+    assert_eq!(report, "fired: expected E2, got none");
+    assert_eq!(out.fired, ["E0", "-"]);
+}
+
+#[test]
+fn names_the_plans_lack_are_refused_with_their_line() {
+    let ir = submarine();
+    let cases = [
+        ("controller: XX\nsteps: []\n", 1, "unknown controller `XX`"),
+        (
+            "controller: PR\nsteps:\n  - command: FLY\n",
+            3,
+            "`PR` has no command `FLY`",
+        ),
+        (
+            "controller: PR\nsteps:\n  - command: { AHEAD: { knots: 3.0 } }\n",
+            3,
+            "command `AHEAD` of `PR` has no parameter `knots`",
+        ),
+        (
+            "controller: PR\nsteps:\n  - command: { AHEAD: { speed: fast } }\n",
+            3,
+            "`speed`: expected f64",
+        ),
+        (
+            "controller: PR\nsteps:\n  - expect: { fired: E9 }\n",
+            3,
+            "no row of `PR` is called `E9`",
+        ),
+        (
+            "controller: PR\nsteps:\n  - hooks: { speed_error: Sideways }\n",
+            3,
+            "`speed_error`: expected SpeedError",
+        ),
+        (
+            "controller: PR\nsteps:\n  - reads: { ship: { heading: 3 } }\n",
+            3,
+            "buffer type `Ship` has no field `heading`",
+        ),
+        (
+            "controller: PR\nsteps:\n  - subordinates: { SM: DONE }\n",
+            3,
+            "`SM` is not a subordinate of `PR`",
+        ),
+        (
+            "controller: PR\nsteps:\n  - expect: { vars: { speed: 1.0 } }\n",
+            3,
+            "`PR` has no var `speed`",
+        ),
+    ];
+    for (text, line, message) in cases {
+        let file = SourceFile::new("t.scenario.yaml", text);
+        let e = scenario::parse(&ir, &file, "t")
+            .err()
+            .unwrap_or_else(|| panic!("accepted: {text}"));
+        assert_eq!(e.line, line, "{text}");
+        assert!(e.message.contains(message), "{text}: {}", e.message);
+    }
+}

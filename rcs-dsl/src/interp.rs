@@ -84,7 +84,7 @@ fn round(v: f64, t: FloatTy) -> f64 {
 }
 
 /// Rust's `as` from a float to an integer: truncate, saturate, NaN → 0.
-fn float_to_int(v: f64, t: IntTy) -> i128 {
+pub fn float_to_int(v: f64, t: IntTy) -> i128 {
     if v.is_nan() {
         return 0;
     }

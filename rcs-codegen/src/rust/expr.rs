@@ -143,40 +143,13 @@ fn float_lit(v: f64, t: &Type) -> Code {
 
 /// Fold a cast of a literal at generation time (clippy dislikes `1i64 as f32`).
 fn fold_cast(e: &Expr, to: &Type) -> Option<Code> {
+    // The interpreter's `as` is the reference; folding must agree with it.
+    use rcs_dsl::interp::{float_to_int, wrap};
     match (&e.kind, to) {
-        (ExprKind::Int(v), Type::Int(it)) => {
-            // Rust `as` between integers keeps the low bits.
-            let bits = match it {
-                IntTy::I8 | IntTy::U8 => 8,
-                IntTy::I16 | IntTy::U16 => 16,
-                IntTy::I32 | IntTy::U32 => 32,
-                IntTy::I64 | IntTy::U64 => 64,
-            };
-            let masked = (*v as u128) & ((1u128 << bits) - 1);
-            let value = if it.signed() && masked >> (bits - 1) == 1 {
-                masked as i128 - (1i128 << bits)
-            } else {
-                masked as i128
-            };
-            Some(int_lit(value, to))
-        }
+        (ExprKind::Int(v), Type::Int(it)) => Some(int_lit(wrap(*v, *it), to)),
         (ExprKind::Int(v), Type::Float(_)) => Some(float_lit(*v as f64, to)),
         (ExprKind::Float(v), Type::Float(_)) => Some(float_lit(*v, to)),
-        (ExprKind::Float(v), Type::Int(it)) => {
-            // Rust `as` from float to integer saturates (NaN → 0).
-            let (lo, hi) = it.range();
-            let t = v.trunc();
-            let value = if t.is_nan() {
-                0
-            } else if t <= lo as f64 {
-                lo
-            } else if t >= hi as f64 {
-                hi
-            } else {
-                t as i128
-            };
-            Some(int_lit(value, to))
-        }
+        (ExprKind::Float(v), Type::Int(it)) => Some(int_lit(float_to_int(*v, *it), to)),
         _ => None,
     }
 }

@@ -203,17 +203,7 @@ impl Resolver<'_> {
         }
         let mut sub_list = Vec::new();
         for (name, v) in object(line, subs.as_ref(), "subordinates")? {
-            let i = self
-                .c
-                .subordinates
-                .iter()
-                .position(|s| self.ir.controller(*s).name == *name)
-                .ok_or_else(|| {
-                    err(
-                        line,
-                        format!("`{name}` is not a subordinate of `{}`", self.c.name),
-                    )
-                })?;
+            let i = self.sub_index(line, name)?;
             let sub = self.ir.controller(self.c.subordinates[i]);
             sub_list.push((i, self.sub_setting(line, sub, v)?));
         }
@@ -234,20 +224,23 @@ impl Resolver<'_> {
 
     /// `INIT` or `{ AHEAD: { speed: 10.0 } }`.
     fn command(&self, line: usize, v: &Json) -> Result<(CommandId, Vec<Value>), ScenarioError> {
-        let (verb, args) = match v {
-            Json::String(s) => (s.as_str(), None),
-            Json::Object(m) if m.len() == 1 => {
-                let (k, a) = m.iter().next().expect("one entry");
-                (k.as_str(), Some(a))
-            }
-            _ => {
-                return Err(err(
+        verb_call(self.ir, self.c, line, v, || {
+            "`command` is a verb (`INIT`) or `{ VERB: { param: value } }`".to_string()
+        })
+    }
+
+    /// The index of subordinate `name` in this controller's `subordinates`.
+    fn sub_index(&self, line: usize, name: &str) -> Result<usize, ScenarioError> {
+        self.c
+            .subordinates
+            .iter()
+            .position(|s| self.ir.controller(*s).name == name)
+            .ok_or_else(|| {
+                err(
                     line,
-                    "`command` is a verb (`INIT`) or `{ VERB: { param: value } }`",
-                ))
-            }
-        };
-        verb_args(self.ir, self.c, line, verb, args)
+                    format!("`{name}` is not a subordinate of `{}`", self.c.name),
+                )
+            })
     }
 
     fn sub_setting(
@@ -378,32 +371,11 @@ impl Resolver<'_> {
         if let Some(sent) = e.sent {
             let mut list = Vec::new();
             for (name, v) in object(line, Some(&sent), "sent")? {
-                let si = self
-                    .c
-                    .subordinates
-                    .iter()
-                    .position(|s| self.ir.controller(*s).name == *name)
-                    .ok_or_else(|| {
-                        err(
-                            line,
-                            format!("`{name}` is not a subordinate of `{}`", self.c.name),
-                        )
-                    })?;
+                let si = self.sub_index(line, name)?;
                 let sub = self.ir.controller(self.c.subordinates[si]);
-                let (verb, args) = match v {
-                    Json::String(s) => (s.as_str(), None),
-                    Json::Object(m) if m.len() == 1 => {
-                        let (k, a) = m.iter().next().expect("one entry");
-                        (k.as_str(), Some(a))
-                    }
-                    _ => {
-                        return Err(err(
-                            line,
-                            format!("`sent.{name}` is a verb or `{{ VERB: {{ param: value }} }}`"),
-                        ))
-                    }
-                };
-                let (cmd, vals) = verb_args(self.ir, sub, line, verb, args)?;
+                let (cmd, vals) = verb_call(self.ir, sub, line, v, || {
+                    format!("`sent.{name}` is a verb or `{{ VERB: {{ param: value }} }}`")
+                })?;
                 list.push((self.c.subordinates[si], cmd, vals));
             }
             out.sent = Some(list);
@@ -461,6 +433,26 @@ fn object<'j>(
             format!("`{what}` is a mapping of names to values"),
         )),
     }
+}
+
+/// `VERB` or `{ VERB: { param: value } }` for controller `c`; `shape`
+/// says what was expected when the value has neither form.
+fn verb_call(
+    ir: &Ir,
+    c: &Controller,
+    line: usize,
+    v: &Json,
+    shape: impl FnOnce() -> String,
+) -> Result<(CommandId, Vec<Value>), ScenarioError> {
+    let (verb, args) = match v {
+        Json::String(s) => (s.as_str(), None),
+        Json::Object(m) if m.len() == 1 => {
+            let (k, a) = m.iter().next().expect("one entry");
+            (k.as_str(), Some(a))
+        }
+        _ => return Err(err(line, shape())),
+    };
+    verb_args(ir, c, line, verb, args)
 }
 
 fn verb_args(

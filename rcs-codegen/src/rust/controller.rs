@@ -681,25 +681,29 @@ fn plan_fn(
         let mut parts: Vec<(Option<Code>, TokenStream)> =
             rows.iter().map(|r| row_code(r, comments)).collect();
         let otherwise = p.otherwise().map(|r| row_code(r, comments).1);
-        // Build from the end: else-branch first.
-        let mut tail: Option<TokenStream> = otherwise;
+        // Build from the end: else-branch first. The flag says whether the
+        // tail is an `if` expression, which may follow `else` directly.
+        let mut tail: Option<(TokenStream, bool)> = otherwise.map(|t| (t, false));
         while let Some((cond, body)) = parts.pop() {
             let cond = cond.expect("only otherwise has no condition");
+            let ts = &cond.ts;
             tail = Some(if cond.has_block {
                 // A hoisted hook call cannot stand in an `if` condition.
-                let ts = &cond.ts;
-                let rest = tail.map(|t| quote!(else { #t })).unwrap_or_default();
-                quote!({ let matched = #ts; if matched { #body } #rest })
+                let rest = tail.map(|(t, _)| quote!(else { #t })).unwrap_or_default();
+                (
+                    quote!({ let matched = #ts; if matched { #body } #rest }),
+                    false,
+                )
             } else {
-                let ts = &cond.ts;
-                match tail {
+                let code = match tail {
                     None => quote!(if #ts { #body }),
-                    Some(t) if t.to_string().starts_with("if ") => quote!(if #ts { #body } else #t),
-                    Some(t) => quote!(if #ts { #body } else { #t }),
-                }
+                    Some((t, true)) => quote!(if #ts { #body } else #t),
+                    Some((t, false)) => quote!(if #ts { #body } else { #t }),
+                };
+                (code, true)
             });
         }
-        tail.unwrap_or_default()
+        tail.map(|(t, _)| t).unwrap_or_default()
     };
 
     let ordinary: Vec<&Row> = p.rows.iter().filter(|r| !r.is_otherwise()).collect();

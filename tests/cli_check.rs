@@ -2,32 +2,10 @@
 //! output formats and its lint flags, as a user meets them.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn rcsc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rcsc"))
-        .args(args)
-        .env("NO_COLOR", "1")
-        .output()
-        .expect("rcsc runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-/// A scratch plan set in a fresh temporary folder.
-fn scratch(name: &str, files: &[(&str, &str)]) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("rcsc-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    for (path, body) in files {
-        let p = dir.join(path);
-        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
-        std::fs::write(p, body).unwrap();
-    }
-    dir
-}
+mod common;
+use common::{rcsc, scratch, text};
 
 const UNUSED_VAR: &str = "controller A {\n    command GO\n    var spare: u8 = 0\n    plan GO {\n        *0 when new_command -> Done\n    }\n}\n";
 

@@ -1,31 +1,10 @@
 //! `rcsc graph` and `rcsc ir` end to end: what they print, where, and with
 //! which exit status (0 / 1 / 2).
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn rcsc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rcsc"))
-        .args(args)
-        .env("NO_COLOR", "1")
-        .output()
-        .expect("rcsc runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-/// A scratch plan set in a fresh temporary folder.
-fn scratch(name: &str, files: &[(&str, &str)]) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("rcsc-graph-ir-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    for (path, body) in files {
-        std::fs::write(dir.join(path), body).unwrap();
-    }
-    dir
-}
+mod common;
+use common::{rcsc, scratch, text};
 
 fn has_dot() -> bool {
     Command::new("dot").arg("-V").output().is_ok()

@@ -1,0 +1,43 @@
+//! What the end-to-end tests of the `rcsc` binary share: running it, its
+//! output as text, and scratch plan-set folders.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Run `rcsc` in `cwd`, without colour.
+pub fn rcsc_in(cwd: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rcsc"))
+        .args(args)
+        .current_dir(cwd)
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("rcsc runs")
+}
+
+/// Run `rcsc` in the repository root (cargo's working folder for tests).
+pub fn rcsc(args: &[&str]) -> Output {
+    rcsc_in(Path::new("."), args)
+}
+
+pub fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// A fresh temporary folder holding `files` (paths may have folders). Its
+/// name carries the test binary, the process and `name`, so tests running
+/// in parallel never share one.
+pub fn scratch(name: &str, files: &[(&str, &str)]) -> PathBuf {
+    let binary = std::env::current_exe()
+        .ok()
+        .and_then(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
+        .unwrap_or_default();
+    let dir = std::env::temp_dir().join(format!("rcsc-{binary}-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (path, body) in files {
+        let p = dir.join(path);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(p, body).unwrap();
+    }
+    dir
+}

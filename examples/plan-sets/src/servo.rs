@@ -106,96 +106,80 @@ impl<
     }
 }
 
-/// The harness's handles: PR's supervisor, the turbine and the ship.
-struct World<P: rcs_runtime::Command, T: rcs_runtime::Command, S: Copy + Default + Send + 'static> {
-    operator: Operator<P>,
-    tb_command: Reader<CommandBuffer<T>>,
-    tb_status: Writer<StatusBuffer>,
-    ship: Writer<S>,
-    pr_status: Reader<StatusBuffer>,
-}
-
-fn world<P: rcs_runtime::Command, T: rcs_runtime::Command, S: Copy + Default + Send + 'static>(
-    gm: &GlobalMemory,
-) -> Result<World<P, T, S>, SetupError> {
-    gm.declare_controller::<T>("TB")?;
-    Ok(World {
-        operator: Operator::connect(gm, "PR")?,
-        tb_command: gm.command_reader("TB")?,
-        tb_status: gm.status_writer("TB")?,
-        ship: gm.writer("ship")?,
-        pr_status: gm.status_reader("PR")?,
-    })
+impl<
+        C: Controller,
+        P: rcs_runtime::Command,
+        T: rcs_runtime::Command,
+        S: Copy + Default + Send + 'static,
+    > RustLoop<C, P, T, S>
+{
+    /// The harness around `ctrl` (already connected to `gm`): PR's
+    /// supervisor, which sends `first` at once, the turbine and the ship.
+    fn new(
+        gm: &GlobalMemory,
+        ctrl: C,
+        make_ship: fn(f64) -> S,
+        rpm_of: fn(&T) -> f64,
+        first: P,
+    ) -> Result<Self, SetupError> {
+        gm.declare_controller::<T>("TB")?;
+        let mut l = RustLoop {
+            ctrl,
+            operator: Operator::connect(gm, "PR")?,
+            tb_command: gm.command_reader("TB")?,
+            tb_status: gm.status_writer("TB")?,
+            ship: gm.writer("ship")?,
+            make_ship,
+            rpm_of,
+            pr_status: gm.status_reader("PR")?,
+            ctx: context(),
+            turn: 0,
+        };
+        l.operator.command(first);
+        Ok(l)
+    }
 }
 
 pub type GeneratedLoop =
     RustLoop<sub::pr::Controller<Model>, sub::pr::Command, sub::tb::Command, sub::types::Ship>;
 pub type HandLoop = RustLoop<hand::Propulsion, hand::PrCommand, hand::TbCommand, hand::Ship>;
 
-/// The generated PR, commanded AHEAD(GOAL), after its first cycle (S1).
+/// The generated PR, commanded AHEAD(GOAL).
 pub fn generated() -> Result<GeneratedLoop, SetupError> {
     let gm = GlobalMemory::new();
     let ctrl = sub::pr::Controller::new(&gm, Model)?;
-    let World {
-        operator,
-        tb_command,
-        tb_status,
-        ship,
-        pr_status,
-    } = world(&gm)?;
-    let mut l = RustLoop {
+    RustLoop::new(
+        &gm,
         ctrl,
-        operator,
-        tb_command,
-        tb_status,
-        ship,
-        make_ship: |speed| sub::types::Ship {
+        |speed| sub::types::Ship {
             direction: sub::types::ShipDirection::Ahead,
             speed,
         },
-        rpm_of: |c| match c {
+        |c| match c {
             sub::tb::Command::Ahead { rpm } => *rpm,
             _ => 0.0,
         },
-        pr_status,
-        ctx: context(),
-        turn: 0,
-    };
-    l.operator.command(sub::pr::Command::Ahead { speed: GOAL });
-    Ok(l)
+        sub::pr::Command::Ahead { speed: GOAL },
+    )
 }
 
 /// The hand-written PR, commanded AHEAD(GOAL).
 pub fn hand_written() -> Result<HandLoop, SetupError> {
     let gm = GlobalMemory::new();
     let ctrl = hand::Propulsion::new(&gm)?;
-    let World {
-        operator,
-        tb_command,
-        tb_status,
-        ship,
-        pr_status,
-    } = world(&gm)?;
-    let mut l = RustLoop {
+    RustLoop::new(
+        &gm,
         ctrl,
-        operator,
-        tb_command,
-        tb_status,
-        ship,
-        make_ship: |speed| hand::Ship {
+        |speed| hand::Ship {
             direction: hand::ShipDirection::Ahead,
             speed,
         },
-        rpm_of: |c| match c {
+        |c| match c {
             hand::TbCommand::Ahead { rpm } => *rpm,
             _ => 0.0,
         },
-        pr_status,
-        ctx: context(),
-        turn: 0,
-    };
-    l.operator.command(hand::PrCommand::Ahead { speed: GOAL });
-    Ok(l)
+        hand::PrCommand::Ahead { speed: GOAL },
+    )
 }
 
 /// The C port with the same world.

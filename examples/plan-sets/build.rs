@@ -1,7 +1,8 @@
 //! Compile every plan set of the repository (`plans/*` and the golden ok
 //! cases `tests/data/ok/*`) through `rcs_codegen::Config`, as a user's
 //! build.rs would. The workspace's `cargo clippy -D warnings` then checks
-//! every generated module. Also builds the C port of the methodology's
+//! every generated module (with the scenario driver, which the
+//! differential tests use). Also builds the C port of the methodology's
 //! controller template for the benchmark.
 
 use std::path::{Path, PathBuf};
@@ -27,6 +28,7 @@ fn module_name(path: &Path) -> String {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = PathBuf::from(std::env::var("OUT_DIR")?);
     let mut includes = String::new();
+    let mut registry = String::new();
     for folder in ["../../plans", "../../tests/data/ok"] {
         let mut entries: Vec<PathBuf> = std::fs::read_dir(folder)?
             .map(|e| e.map(|e| e.path()))
@@ -47,6 +49,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             rcs_codegen::Config::new()
                 .out_dir(&dest)
                 .graphs(false)
+                .driver(true)
                 .compile(&path)?;
             let rust = std::fs::read_dir(dest.join("rust"))?
                 .map(|e| e.map(|e| e.path()))
@@ -58,8 +61,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 "pub mod {module} {{\n    include!({:?});\n}}\n",
                 rust.display().to_string()
             ));
+            // The generated file is `rust/<system>.rs` holding `pub mod <system>`.
+            let system = rust
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            let system_mod = rcs_codegen::ident::ident(&rcs_codegen::ident::snake(&system));
+            let rel = path
+                .strip_prefix("../../")
+                .unwrap_or(&path)
+                .display()
+                .to_string();
+            registry.push_str(&format!(
+                "    PlanSet {{ path: {rel:?}, new_driver: {module}::{system_mod}::new_driver }},\n"
+            ));
         }
     }
+    includes.push_str(&format!(
+        "/// Every plan set above: its path from the workspace root and its\n\
+         /// generated scenario driver.\npub const SETS: &[PlanSet] = &[\n{registry}];\n"
+    ));
     std::fs::write(out.join("sets.rs"), includes)?;
 
     println!("cargo::rerun-if-changed=c/pr_template.c");

@@ -38,6 +38,7 @@ pub struct Config {
     manifest_dir: Option<PathBuf>,
     lints: Vec<(Lint, Level)>,
     graphs: bool,
+    options: crate::Options,
 }
 
 /// Why [`Config::compile`] failed. Its `Debug` is its message, so that a
@@ -92,6 +93,7 @@ impl Config {
             manifest_dir: None,
             lints: Vec::new(),
             graphs: true,
+            options: crate::Options::default(),
         }
     }
 
@@ -113,6 +115,15 @@ impl Config {
     /// Later calls override earlier ones.
     pub fn lint(&mut self, lint: Lint, level: Level) -> &mut Config {
         self.lints.push((lint, level));
+        self
+    }
+
+    /// Also generate the scenario driver (default: no): per controller a
+    /// `Driver` implementing `rcs_runtime::driver::Driven`, and
+    /// `new_driver(name)` for the plan set — for tests that run generated
+    /// controllers alone against scripted inputs.
+    pub fn driver(&mut self, yes: bool) -> &mut Config {
+        self.options.driver = yes;
         self
     }
 
@@ -186,7 +197,7 @@ impl Config {
             }
         };
 
-        let mut files = crate::generate(&ir);
+        let mut files = crate::generate_with(&ir, &self.options);
         if !self.graphs {
             files.retain(|f| !f.path.starts_with("graphs/") && !f.path.starts_with("tables/"));
         }

@@ -30,11 +30,25 @@ pub struct OutputFile {
     pub contents: String,
 }
 
+/// What to generate beyond the defaults.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Options {
+    /// Also emit the scenario driver: a `Driver` per controller implementing
+    /// `rcs_runtime::driver::Driven` (for `rcsc test --backend compiled`
+    /// and differential tests; not needed by a running system).
+    pub driver: bool,
+}
+
 /// Every output of one plan set, in a fixed order.
 pub fn generate(ir: &Ir) -> Vec<OutputFile> {
+    generate_with(ir, &Options::default())
+}
+
+/// [`generate`] with [`Options`].
+pub fn generate_with(ir: &Ir, options: &Options) -> Vec<OutputFile> {
     let mut files = vec![OutputFile {
         path: format!("rust/{}.rs", ir.system),
-        contents: rust::system_module(ir),
+        contents: rust::system_module(ir, options),
     }];
     for ctrl in &ir.controllers {
         for cmd in &ctrl.commands {

@@ -16,48 +16,70 @@ use rcs_runtime::{
     Bookkeeping, ErrorCode, Stamped, Status, StatusBuffer, SubordinateLink, SubordinateView, Tick,
 };
 
-/// A run-time value. Integers are kept in range of their type; `f32`
-/// values are kept exactly representable as `f32`.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-#[serde(untagged)]
-pub enum Value {
-    Bool(bool),
-    Int(i128),
-    Float(f64),
-    /// An enum variant by index.
-    Enum(u32),
-    /// A status code (`rcs_runtime::Status`).
-    Status(u16),
-    /// A buffer's fields in declaration order.
-    Buffer(Vec<Value>),
-    Array(Vec<Value>),
-    Unit,
+pub use rcs_runtime::driver::Value;
+
+/// The zero value of a type: numbers 0, `false`, the first variant.
+pub fn zero(ir: &Ir, t: &Type) -> Value {
+    match t {
+        Type::Bool => Value::Bool(false),
+        Type::Int(_) => Value::Int(0),
+        Type::Float(_) => Value::Float(0.0),
+        Type::Enum(_) => Value::Enum(0),
+        Type::Status(_) => Value::Status(0),
+        Type::Buffer(b) => Value::Buffer(
+            ir.buffer_types[b.index()]
+                .fields
+                .iter()
+                .map(|f| zero(ir, &f.ty))
+                .collect(),
+        ),
+        Type::Array(e, n) => Value::Array(vec![zero(ir, e); *n as usize]),
+        Type::Unit => Value::Unit,
+    }
 }
 
-impl Value {
-    /// The zero value of a type: numbers 0, `false`, the first variant.
-    pub fn zero(ir: &Ir, t: &Type) -> Value {
-        match t {
-            Type::Bool => Value::Bool(false),
-            Type::Int(_) => Value::Int(0),
-            Type::Float(_) => Value::Float(0.0),
-            Type::Enum(_) => Value::Enum(0),
-            Type::Status(_) => Value::Status(0),
-            Type::Buffer(b) => Value::Buffer(
-                ir.buffer_types[b.index()]
-                    .fields
-                    .iter()
-                    .map(|f| Value::zero(ir, &f.ty))
-                    .collect(),
-            ),
-            Type::Array(e, n) => Value::Array(vec![Value::zero(ir, e); *n as usize]),
-            Type::Unit => Value::Unit,
+/// `v` as a value of type `t`, as the generated code would hold it (`f32`
+/// rounded), or `None` when it has another shape or is out of range.
+pub fn conform(ir: &Ir, t: &Type, v: &Value) -> Option<Value> {
+    Some(match (t, v) {
+        (Type::Bool, Value::Bool(b)) => Value::Bool(*b),
+        (Type::Int(it), Value::Int(i)) => {
+            let (lo, hi) = it.range();
+            if *i < lo || *i > hi {
+                return None;
+            }
+            Value::Int(*i)
         }
-    }
+        (Type::Float(ft), Value::Float(f)) => Value::Float(round(*f, *ft)),
+        (Type::Enum(e), Value::Enum(i)) if (*i as usize) < ir.enums[e.index()].variants.len() => {
+            Value::Enum(*i)
+        }
+        (Type::Status(_), Value::Status(s)) => Value::Status(*s),
+        (Type::Buffer(b), Value::Buffer(fs)) => {
+            let bt = &ir.buffer_types[b.index()];
+            if fs.len() != bt.fields.len() {
+                return None;
+            }
+            Value::Buffer(
+                bt.fields
+                    .iter()
+                    .zip(fs)
+                    .map(|(f, x)| conform(ir, &f.ty, x))
+                    .collect::<Option<_>>()?,
+            )
+        }
+        (Type::Array(e, n), Value::Array(xs)) if xs.len() == *n as usize => Value::Array(
+            xs.iter()
+                .map(|x| conform(ir, e, x))
+                .collect::<Option<_>>()?,
+        ),
+        (Type::Unit, Value::Unit) => Value::Unit,
+        _ => return None,
+    })
+}
 
-    pub fn as_bool(&self) -> bool {
-        matches!(self, Value::Bool(true))
-    }
+fn truthy(v: &Value) -> bool {
+    matches!(v, Value::Bool(true))
 }
 
 /// An integer wrapped into the range of its type (keeps the low bits).
@@ -179,12 +201,12 @@ impl<'ir> Interpreter<'ir> {
             reads: c
                 .reads
                 .iter()
-                .map(|b| Value::zero(ir, &Type::Buffer(ir.buffers[b.index()].ty)))
+                .map(|b| zero(ir, &Type::Buffer(ir.buffers[b.index()].ty)))
                 .collect(),
             writes: c
                 .writes
                 .iter()
-                .map(|b| Value::zero(ir, &Type::Buffer(ir.buffers[b.index()].ty)))
+                .map(|b| zero(ir, &Type::Buffer(ir.buffers[b.index()].ty)))
                 .collect(),
             subs: c
                 .subordinates
@@ -202,7 +224,7 @@ impl<'ir> Interpreter<'ir> {
             .iter()
             .map(|v| match &v.init {
                 Some(e) => me.eval(e, &mut no_hooks),
-                None => Value::zero(ir, &v.ty),
+                None => zero(ir, &v.ty),
             })
             .collect();
         me
@@ -318,7 +340,7 @@ impl<'ir> Interpreter<'ir> {
                 continue;
             }
             if let Condition::When(c) = &r.cond {
-                if self.eval(c, hooks).as_bool() {
+                if truthy(&self.eval(c, hooks)) {
                     chosen = Some(r);
                     break;
                 }
@@ -517,10 +539,10 @@ impl<'ir> Interpreter<'ir> {
     fn binary(&mut self, op: BinOp, l: &Expr, r: &Expr, ty: &Type, hooks: &mut dyn Hooks) -> Value {
         match op {
             BinOp::And => {
-                return Value::Bool(self.eval(l, hooks).as_bool() && self.eval(r, hooks).as_bool())
+                return Value::Bool(truthy(&self.eval(l, hooks)) && truthy(&self.eval(r, hooks)))
             }
             BinOp::Or => {
-                return Value::Bool(self.eval(l, hooks).as_bool() || self.eval(r, hooks).as_bool())
+                return Value::Bool(truthy(&self.eval(l, hooks)) || truthy(&self.eval(r, hooks)))
             }
             _ => {}
         }
@@ -587,5 +609,165 @@ struct NoHooks;
 impl Hooks for NoHooks {
     fn call(&mut self, _: &HookData, _: HookId, _: &[Value]) -> Value {
         Value::Unit
+    }
+}
+
+/// The interpreter as a [`Driven`](rcs_runtime::driver::Driven) controller,
+/// the interface the generated `Driver`s implement too: names resolved
+/// against the IR, values checked against their declared types, and hooks
+/// that return what the caller last set (their type's zero before that).
+pub struct Driven<'ir> {
+    ir: &'ir Ir,
+    interp: Interpreter<'ir>,
+    hooks: Scripted<'ir>,
+}
+
+struct Scripted<'ir> {
+    ir: &'ir Ir,
+    values: Vec<Option<Value>>,
+}
+
+impl Hooks for Scripted<'_> {
+    fn call(&mut self, data: &HookData, hook: HookId, _: &[Value]) -> Value {
+        self.values[hook.index()]
+            .clone()
+            .unwrap_or_else(|| zero(self.ir, &data.ctrl.hooks[hook.index()].ret))
+    }
+}
+
+impl<'ir> Driven<'ir> {
+    /// Controller `ctrl`, fresh (as [`Interpreter::new`]).
+    pub fn new(ir: &'ir Ir, ctrl: CtrlId) -> Driven<'ir> {
+        let interp = Interpreter::new(ir, ctrl);
+        let hooks = Scripted {
+            ir,
+            values: vec![None; interp.controller().hooks.len()],
+        };
+        Driven { ir, interp, hooks }
+    }
+
+    /// The interpreter underneath.
+    pub fn interpreter(&self) -> &Interpreter<'ir> {
+        &self.interp
+    }
+
+    fn sub_index(&self, sub: &str) -> Result<usize, rcs_runtime::driver::DriveError> {
+        let c = self.interp.controller();
+        c.subordinates
+            .iter()
+            .position(|s| self.ir.controller(*s).name == sub)
+            .ok_or_else(|| rcs_runtime::driver::unknown(&c.name, "subordinate", sub))
+    }
+
+    fn typed(
+        &self,
+        t: &Type,
+        what: &str,
+        v: &Value,
+    ) -> Result<Value, rcs_runtime::driver::DriveError> {
+        conform(self.ir, t, v).ok_or_else(|| rcs_runtime::driver::DriveError::Type {
+            controller: self.interp.controller().name.clone(),
+            what: what.to_string(),
+        })
+    }
+}
+
+impl rcs_runtime::driver::Driven for Driven<'_> {
+    fn name(&self) -> &str {
+        &self.interp.controller().name
+    }
+
+    fn command(
+        &mut self,
+        verb: &str,
+        args: &[Value],
+    ) -> Result<u32, rcs_runtime::driver::DriveError> {
+        let c = self.interp.controller();
+        let id = c
+            .commands
+            .iter()
+            .position(|k| k.name == verb)
+            .ok_or_else(|| rcs_runtime::driver::unknown(&c.name, "verb", verb))?;
+        let cmd = &c.commands[id];
+        rcs_runtime::driver::arity(&c.name, verb, args, cmd.params.len())?;
+        let args = cmd
+            .params
+            .iter()
+            .zip(args)
+            .map(|(p, a)| self.typed(&p.ty, &format!("{verb}.{}", p.name), a))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(self.interp.command(CommandId(id as u32), args))
+    }
+
+    fn set_read(
+        &mut self,
+        buffer: &str,
+        value: &Value,
+    ) -> Result<(), rcs_runtime::driver::DriveError> {
+        let c = self.interp.controller();
+        let i = c
+            .reads
+            .iter()
+            .position(|b| self.ir.buffers[b.index()].name == buffer)
+            .ok_or_else(|| rcs_runtime::driver::unknown(&c.name, "read buffer", buffer))?;
+        let ty = Type::Buffer(self.ir.buffers[c.reads[i].index()].ty);
+        let v = self.typed(&ty, buffer, value)?;
+        self.interp.set_read(i, v);
+        Ok(())
+    }
+
+    fn set_hook(
+        &mut self,
+        hook: &str,
+        value: &Value,
+    ) -> Result<(), rcs_runtime::driver::DriveError> {
+        let c = self.interp.controller();
+        let i = c
+            .hooks
+            .iter()
+            .position(|h| h.name == hook)
+            .ok_or_else(|| rcs_runtime::driver::unknown(&c.name, "hook", hook))?;
+        let v = self.typed(&c.hooks[i].ret, hook, value)?;
+        self.hooks.values[i] = Some(v);
+        Ok(())
+    }
+
+    fn write_sub_status(
+        &mut self,
+        sub: &str,
+        status: StatusBuffer,
+    ) -> Result<(), rcs_runtime::driver::DriveError> {
+        let i = self.sub_index(sub)?;
+        self.interp.write_sub_status(i, status);
+        Ok(())
+    }
+
+    fn last_sent(&self, sub: &str) -> Result<u32, rcs_runtime::driver::DriveError> {
+        Ok(self.interp.last_sent(self.sub_index(sub)?))
+    }
+
+    fn cycle(&mut self) -> rcs_runtime::driver::Record {
+        let rec = self.interp.cycle(&mut self.hooks);
+        let c = self.interp.controller();
+        rcs_runtime::driver::Record {
+            cycle: rec.cycle,
+            verb: rec.verb.map(|v| v.0 as u16),
+            fired: rec.fired.map(|r| r.0 as u16),
+            state: rec.state.0 as u16,
+            status: Status(rec.status.0 as u16),
+            error: ErrorCode(rec.error.unwrap_or(0)),
+            sent: rec
+                .sent
+                .into_iter()
+                .map(|s| rcs_runtime::driver::Sent {
+                    sub: c.subordinates.iter().position(|x| *x == s.sub).unwrap_or(0) as u16,
+                    verb: s.command.0 as u16,
+                    args: s.args,
+                    serial: s.serial,
+                })
+                .collect(),
+            vars: rec.vars,
+            writes: rec.writes,
+        }
     }
 }

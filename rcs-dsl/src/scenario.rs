@@ -5,10 +5,11 @@
 //! [`crate::yaml`]), resolves every name against the IR, and runs it on
 //! the reference interpreter.
 
-use crate::interp::{wrap, HookData, Hooks, Interpreter, Value};
+use crate::interp::{self, wrap, zero, Value};
 use crate::ir::*;
 use crate::source::SourceFile;
 use crate::yaml::{self, Spanned};
+use rcs_runtime::driver::{Driven, Record};
 use rcs_runtime::{Status, StatusBuffer};
 use serde::Deserialize;
 use serde_json::Value as Json;
@@ -187,7 +188,7 @@ impl Resolver<'_> {
                 .ok_or_else(|| err(line, format!("`{}` reads no buffer `{name}`", self.c.name)))?;
             // Check the shape now; values merge into the current buffer when run.
             let ty = Type::Buffer(self.ir.buffers[self.c.reads[i].index()].ty);
-            merge(self.ir, line, &Value::zero(self.ir, &ty), &ty, v, name)?;
+            merge(self.ir, line, &zero(self.ir, &ty), &ty, v, name)?;
             read_list.push((i, v.clone()));
         }
         let mut hook_list = Vec::new();
@@ -398,7 +399,7 @@ impl Resolver<'_> {
                 .position(|b| self.ir.buffers[b.index()].name == *name)
                 .ok_or_else(|| err(line, format!("`{}` writes no buffer `{name}`", self.c.name)))?;
             let ty = Type::Buffer(self.ir.buffers[self.c.writes[i].index()].ty);
-            merge(self.ir, line, &Value::zero(self.ir, &ty), &ty, v, name)?;
+            merge(self.ir, line, &zero(self.ir, &ty), &ty, v, name)?;
             out.writes.push((i, v.clone()));
         }
         Ok(out)
@@ -530,7 +531,7 @@ fn value(ir: &Ir, line: usize, t: &Type, v: &Json, what: &str) -> Result<Value, 
                 .position(|x| x.name == *s)
                 .ok_or_else(bad)? as u32,
         ),
-        (Type::Buffer(_), Json::Object(_)) => merge(ir, line, &Value::zero(ir, t), t, v, what)?,
+        (Type::Buffer(_), Json::Object(_)) => merge(ir, line, &zero(ir, t), t, v, what)?,
         (Type::Array(elem, n), Json::Array(items)) if items.len() == *n as usize => Value::Array(
             items
                 .iter()
@@ -577,21 +578,8 @@ pub struct Outcome {
     pub failure: Option<(usize, String)>,
     /// Rows fired, by name, cycle by cycle (`-` for none).
     pub fired: Vec<String>,
-}
-
-struct ScenarioHooks<'a> {
-    ir: &'a Ir,
-    values: BTreeMap<u32, Value>,
-}
-
-impl Hooks for ScenarioHooks<'_> {
-    /// The value the scenario gives the hook, or its type's zero.
-    fn call(&mut self, data: &HookData, hook: HookId, _: &[Value]) -> Value {
-        self.values
-            .get(&hook.0)
-            .cloned()
-            .unwrap_or_else(|| Value::zero(self.ir, &data.ctrl.hooks[hook.index()].ret))
-    }
+    /// Rows fired as (verb, row), cycle by cycle, for coverage.
+    pub rows: Vec<(CommandId, RowId)>,
 }
 
 fn float_eq(a: &Value, b: &Value) -> bool {
@@ -604,14 +592,39 @@ fn float_eq(a: &Value, b: &Value) -> bool {
     }
 }
 
-/// Run a scenario on the interpreter.
+/// Run a scenario on the reference interpreter.
 pub fn run(ir: &Ir, s: &Scenario) -> Outcome {
-    let c = ir.controller(s.controller);
-    let mut interp = Interpreter::new(ir, s.controller);
-    let mut hooks = ScenarioHooks {
-        ir,
-        values: BTreeMap::new(),
+    run_on(ir, s, &mut interp::Driven::new(ir, s.controller))
+}
+
+/// Run a scenario on any backend: the interpreter or a generated `Driver`
+/// of the same controller, fresh.
+pub fn run_on(ir: &Ir, s: &Scenario, driven: &mut dyn Driven) -> Outcome {
+    let mut out = Outcome {
+        name: s.name.clone(),
+        failure: None,
+        fired: Vec::new(),
+        rows: Vec::new(),
     };
+    if let Err((line, report)) = drive(ir, s, driven, &mut out) {
+        out.failure = Some((line, report));
+    }
+    out
+}
+
+fn drive(
+    ir: &Ir,
+    s: &Scenario,
+    d: &mut dyn Driven,
+    out: &mut Outcome,
+) -> Result<(), (usize, String)> {
+    let c = ir.controller(s.controller);
+    let sub_name = |i: usize| ir.controller(c.subordinates[i]).name.as_str();
+    let mut reads: Vec<Value> = c
+        .reads
+        .iter()
+        .map(|b| zero(ir, &Type::Buffer(ir.buffers[b.index()].ty)))
+        .collect();
     let mut subs: Vec<SubSetting> = vec![
         SubSetting {
             status: 0,
@@ -620,29 +633,31 @@ pub fn run(ir: &Ir, s: &Scenario) -> Outcome {
         };
         c.subordinates.len()
     ];
-    let mut fired = Vec::new();
     for (k, step) in std::iter::once(&s.initial).chain(&s.steps).enumerate() {
+        let line = step.line;
+        let fail = |e: rcs_runtime::driver::DriveError| (line, e.to_string());
         if let Some((cmd, args)) = &step.command {
-            interp.command(*cmd, args.clone());
+            d.command(&c.commands[cmd.index()].name, args)
+                .map_err(fail)?;
         }
         for (i, v) in &step.reads {
-            let ty = Type::Buffer(ir.buffers[c.reads[*i].index()].ty);
-            if let Ok(merged) = merge(ir, step.line, &interp.reads()[*i], &ty, v, "reads") {
-                interp.set_read(*i, merged);
-            }
+            let b = &ir.buffers[c.reads[*i].index()];
+            let merged = merge(ir, line, &reads[*i], &Type::Buffer(b.ty), v, &b.name)
+                .map_err(|e| (e.line, e.message))?;
+            d.set_read(&b.name, &merged).map_err(fail)?;
+            reads[*i] = merged;
         }
         for (h, v) in &step.hooks {
-            hooks.values.insert(h.0, v.clone());
+            d.set_hook(&c.hooks[h.index()].name, v).map_err(fail)?;
         }
         // `echo: current` is the serial last sent as of the start of the step.
-        let mut echoes: Vec<u32> = subs
-            .iter()
-            .enumerate()
-            .map(|(i, s)| echo_of(s.echo, interp.last_sent(i)))
-            .collect();
+        let mut echoes = Vec::with_capacity(subs.len());
+        for (i, sub) in subs.iter().enumerate() {
+            echoes.push(echo_of(sub.echo, d.last_sent(sub_name(i)).map_err(fail)?));
+        }
         for (i, setting) in &step.subs {
             subs[*i] = setting.clone();
-            echoes[*i] = echo_of(setting.echo, interp.last_sent(*i));
+            echoes[*i] = echo_of(setting.echo, d.last_sent(sub_name(*i)).map_err(fail)?);
         }
         if k == 0 {
             continue; // `initial` sets the scene; it runs no cycle.
@@ -651,38 +666,32 @@ pub fn run(ir: &Ir, s: &Scenario) -> Outcome {
         for _ in 0..step.cycles {
             for (i, sub) in subs.iter().enumerate() {
                 if !sub.silent {
-                    interp.write_sub_status(
-                        i,
-                        StatusBuffer {
-                            echo_serial: echoes[i],
-                            status: Status(sub.status),
-                            ..StatusBuffer::default()
-                        },
-                    );
+                    let status = StatusBuffer {
+                        echo_serial: echoes[i],
+                        status: Status(sub.status),
+                        ..StatusBuffer::default()
+                    };
+                    d.write_sub_status(sub_name(i), status).map_err(fail)?;
                 }
             }
-            let rec = interp.cycle(&mut hooks);
-            fired.push(
+            let rec = d.cycle();
+            out.fired.push(
                 rec.fired
                     .map(|r| fired_name(c, &rec, r))
                     .unwrap_or_else(|| "-".to_string()),
             );
+            if let (Some(v), Some(r)) = (rec.verb, rec.fired) {
+                out.rows
+                    .push((CommandId(u32::from(v)), RowId(u32::from(r))));
+            }
             last = Some(rec);
         }
         let rec = last.expect("a step runs at least one cycle");
         if let Some(report) = check(ir, c, &step.expect, &rec) {
-            return Outcome {
-                name: s.name.clone(),
-                failure: Some((step.line, report)),
-                fired,
-            };
+            return Err((line, report));
         }
     }
-    Outcome {
-        name: s.name.clone(),
-        failure: None,
-        fired,
-    }
+    Ok(())
 }
 
 fn echo_of(e: Echo, last_sent: u32) -> u32 {
@@ -693,24 +702,27 @@ fn echo_of(e: Echo, last_sent: u32) -> u32 {
     }
 }
 
-fn plan_of<'c>(c: &'c Controller, rec: &crate::interp::CycleRecord) -> Option<&'c Plan> {
+fn plan_of<'c>(c: &'c Controller, rec: &Record) -> Option<&'c Plan> {
     rec.verb
-        .and_then(|v| c.commands[v.index()].plan)
+        .and_then(|v| c.commands.get(usize::from(v))?.plan)
         .map(|p| &c.plans[p.index()])
 }
 
-fn fired_name(c: &Controller, rec: &crate::interp::CycleRecord, row: RowId) -> String {
+fn fired_name(c: &Controller, rec: &Record, row: u16) -> String {
     plan_of(c, rec)
-        .map(|p| p.rows[row.index()].display_name())
-        .unwrap_or_else(|| format!("#{}", row.0))
+        .and_then(|p| p.rows.get(usize::from(row)))
+        .map(|r| r.display_name())
+        .unwrap_or_else(|| format!("#{row}"))
 }
 
 /// Compare a step's expectations with the last cycle; `None` when all hold.
-fn check(ir: &Ir, c: &Controller, e: &Expect, rec: &crate::interp::CycleRecord) -> Option<String> {
+fn check(ir: &Ir, c: &Controller, e: &Expect, rec: &Record) -> Option<String> {
     let mut problems = Vec::new();
     let plan = plan_of(c, rec);
     if let Some(want) = &e.fired {
-        let got = rec.fired.and_then(|r| plan.map(|p| &p.rows[r.index()]));
+        let got = rec
+            .fired
+            .and_then(|r| plan.and_then(|p| p.rows.get(usize::from(r))));
         let ok = match (want, got) {
             (None, None) => true,
             (Some(name), Some(row)) => row_names(row).contains(name),
@@ -728,14 +740,15 @@ fn check(ir: &Ir, c: &Controller, e: &Expect, rec: &crate::interp::CycleRecord) 
     }
     if let Some(want) = &e.state {
         let got = plan
-            .map(|p| p.states[rec.state.index()].name.clone())
+            .and_then(|p| p.states.get(usize::from(rec.state)))
+            .map(|s| s.name.clone())
             .unwrap_or_else(|| "S0".into());
         if *want != got {
             problems.push(format!("state: expected {want}, got {got}"));
         }
     }
     if let Some(want) = e.status {
-        if u32::from(want) != rec.status.0 {
+        if want != rec.status.0 {
             let name = |i: u32| {
                 c.statuses
                     .get(i as usize)
@@ -745,12 +758,13 @@ fn check(ir: &Ir, c: &Controller, e: &Expect, rec: &crate::interp::CycleRecord) 
             problems.push(format!(
                 "status: expected {}, got {}",
                 name(u32::from(want)),
-                name(rec.status.0)
+                name(u32::from(rec.status.0))
             ));
         }
     }
     if let Some(want) = &e.error {
-        if *want != rec.error {
+        let got = (!rec.error.is_none()).then_some(rec.error.0);
+        if *want != got {
             let name = |x: Option<u16>| match x {
                 None => "none".to_string(),
                 Some(1) => "UNKNOWN_COMMAND".to_string(),
@@ -763,7 +777,7 @@ fn check(ir: &Ir, c: &Controller, e: &Expect, rec: &crate::interp::CycleRecord) 
             problems.push(format!(
                 "error: expected {}, got {}",
                 name(*want),
-                name(rec.error)
+                name(got)
             ));
         }
     }
@@ -771,7 +785,13 @@ fn check(ir: &Ir, c: &Controller, e: &Expect, rec: &crate::interp::CycleRecord) 
         let got: Vec<(CtrlId, CommandId, Vec<Value>)> = rec
             .sent
             .iter()
-            .map(|s| (s.sub, s.command, s.args.clone()))
+            .map(|s| {
+                (
+                    c.subordinates[usize::from(s.sub)],
+                    CommandId(u32::from(s.verb)),
+                    s.args.clone(),
+                )
+            })
             .collect();
         let same = want.len() == got.len()
             && want.iter().all(|w| {

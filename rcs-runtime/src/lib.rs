@@ -177,6 +177,7 @@
 
 #![warn(missing_docs)]
 
+pub mod driver;
 pub mod error;
 pub mod exec;
 pub mod gm;

@@ -5,6 +5,16 @@
 
 include!(concat!(env!("OUT_DIR"), "/sets.rs"));
 
+/// One plan set of the repository, compiled with its scenario driver.
+pub struct PlanSet {
+    /// The folder or `.rcs` file, relative to the workspace root.
+    pub path: &'static str,
+    /// A fresh generated controller of the set, by name, behind
+    /// `rcs_runtime::driver::Driven` (`None`: no such controller).
+    pub new_driver:
+        fn(&str) -> Option<Result<Box<dyn rcs_runtime::driver::Driven>, rcs_runtime::SetupError>>,
+}
+
 pub mod c_port;
 pub mod hand;
 pub mod servo;

@@ -44,7 +44,14 @@ pub(crate) fn is_zero(e: &Expr) -> bool {
     }
 }
 
-pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments) -> TokenStream {
+/// `extra`: more items for the module (the scenario driver).
+pub(crate) fn module(
+    ir: &Ir,
+    names: &Names,
+    ci: usize,
+    comments: &mut Comments,
+    extra: TokenStream,
+) -> TokenStream {
     let c = &ir.controllers[ci];
     let n = &names.ctrls[ci];
     let name = &c.name;
@@ -58,9 +65,10 @@ pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments)
 
     // ---- commands
     let verb_count = c.commands.len();
+    let no_commands_doc = format!(" `{name}` accepts no commands.");
     let command_enum = if c.commands.is_empty() {
         quote! {
-            /// `#name` accepts no commands.
+            #[doc = #no_commands_doc]
             #[derive(Clone, Copy, Debug, Default, PartialEq)]
             pub struct Command;
             impl rt::Command for Command {
@@ -373,6 +381,9 @@ pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments)
             .to_string(),
     );
     let step3 = comments.marker("3. A new serial starts the plan of its verb in S0.".to_string());
+    let status_doc =
+        format!(" `{name}`'s statuses as runtime values: the built-ins, then its own.");
+    let error_doc = format!(" `{name}`'s error codes as runtime values.");
     let step4 = comments.marker("4. Decide: the active plan fires at most one row.".to_string());
     let step5 =
         comments.marker("5. Write: status, written buffers, commands sent this cycle.".to_string());
@@ -389,13 +400,13 @@ pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments)
 
             #command_enum
 
-            /// `#name`'s statuses as runtime values: the built-ins, then its own.
+            #[doc = #status_doc]
             pub mod status {
                 use ::rcs_runtime as rt;
                 #(#status_consts)*
             }
 
-            /// `#name`'s error codes as runtime values.
+            #[doc = #error_doc]
             pub mod error {
                 use ::rcs_runtime as rt;
                 /// No error.
@@ -562,6 +573,8 @@ pub(crate) fn module(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments)
 
                 fn bookkeeping(&self) -> Option<&rt::Bookkeeping> { Some(&self.bk) }
             }
+
+            #extra
         }
     }
 }

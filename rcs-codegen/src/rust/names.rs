@@ -91,7 +91,7 @@ impl Names {
         let modules = distinct(
             ir.controllers.iter().map(|c| c.name.as_str()),
             snake,
-            &["types", "rt"],
+            &["types", "rt", "new_driver"],
         );
         let ctrls = ir
             .controllers

@@ -13,7 +13,8 @@ fn docs(lines: &[String]) -> TokenStream {
     quote!(#(#[doc = #lines])*)
 }
 
-pub(crate) fn module(ir: &Ir, names: &Names) -> TokenStream {
+/// `extra`: more items for the module (the driver's conversions).
+pub(crate) fn module(ir: &Ir, names: &Names, extra: TokenStream) -> TokenStream {
     let enums = ir.enums.iter().enumerate().map(|(i, e)| {
         let n = &names.enums[i];
         let ty = &n.ty;
@@ -78,6 +79,7 @@ pub(crate) fn module(ir: &Ir, names: &Names) -> TokenStream {
         pub mod types {
             #(#enums)*
             #(#buffers)*
+            #extra
         }
     }
 }

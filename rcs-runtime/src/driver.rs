@@ -1,0 +1,357 @@
+//! Driving one controller alone, by name, from outside: the interface a
+//! scenario runner or a differential test needs.
+//!
+//! A [`Driven`] controller plays against a world the caller scripts: the
+//! caller writes its supervisor's command, its `reads` buffers, the results
+//! its hooks return and its subordinates' status buffers, runs one cycle,
+//! and gets back a [`Record`] of what the cycle did. rcsc has two backends
+//! behind this one trait — the reference interpreter (`rcs-dsl`) and the
+//! generated code (`rcs-codegen` emits a `Driver` per controller when asked
+//! to, e.g. `Config::driver(true)`) — so a scenario means the same on both
+//! and their traces can be compared cycle by cycle.
+//!
+//! Values cross this interface as dynamic [`Value`]s, which allocate: this
+//! is test tooling, never the cycle path of a running system.
+
+use crate::handshake::{ErrorCode, RowId, StateId, Status, StatusBuffer, VerbId};
+use serde::{Deserialize, Serialize};
+
+/// A value of any plan type, as the interpreter computes it and as the
+/// generated types convert to and from it ([`ToValue`], [`FromValue`]).
+///
+/// Integers hold every width (range is the type's business); `f32` values
+/// are held as the `f64` of the same number.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Value {
+    /// `bool`.
+    Bool(bool),
+    /// Any integer type.
+    Int(i128),
+    /// `f32` or `f64`.
+    Float(f64),
+    /// An enum variant by its declaration index.
+    Enum(u32),
+    /// A status code ([`Status`]).
+    Status(u16),
+    /// A buffer's fields in declaration order.
+    Buffer(Vec<Value>),
+    /// An array's elements.
+    Array(Vec<Value>),
+    /// No value (hooks returning nothing).
+    Unit,
+}
+
+/// A typed value as a [`Value`].
+pub trait ToValue {
+    /// The dynamic value.
+    fn to_value(&self) -> Value;
+}
+
+/// A typed value from a [`Value`]: `None` when the value has another shape
+/// or is out of the type's range.
+pub trait FromValue: Sized {
+    /// The typed value.
+    fn from_value(v: &Value) -> Option<Self>;
+}
+
+impl ToValue for bool {
+    fn to_value(&self) -> Value {
+        Value::Bool(*self)
+    }
+}
+
+impl FromValue for bool {
+    fn from_value(v: &Value) -> Option<Self> {
+        match v {
+            Value::Bool(b) => Some(*b),
+            _ => None,
+        }
+    }
+}
+
+macro_rules! int_values {
+    ($($t:ty),*) => {$(
+        impl ToValue for $t {
+            fn to_value(&self) -> Value {
+                Value::Int(i128::from(*self))
+            }
+        }
+        impl FromValue for $t {
+            fn from_value(v: &Value) -> Option<Self> {
+                match v {
+                    Value::Int(i) => <$t>::try_from(*i).ok(),
+                    _ => None,
+                }
+            }
+        }
+    )*};
+}
+
+int_values!(i8, i16, i32, i64, u8, u16, u32, u64);
+
+impl ToValue for f64 {
+    fn to_value(&self) -> Value {
+        Value::Float(*self)
+    }
+}
+
+impl FromValue for f64 {
+    fn from_value(v: &Value) -> Option<Self> {
+        match v {
+            Value::Float(f) => Some(*f),
+            _ => None,
+        }
+    }
+}
+
+impl ToValue for f32 {
+    fn to_value(&self) -> Value {
+        Value::Float(f64::from(*self))
+    }
+}
+
+impl FromValue for f32 {
+    /// Rounds to the nearest `f32`, as the generated arithmetic does.
+    fn from_value(v: &Value) -> Option<Self> {
+        match v {
+            Value::Float(f) => Some(*f as f32),
+            _ => None,
+        }
+    }
+}
+
+impl ToValue for Status {
+    fn to_value(&self) -> Value {
+        Value::Status(self.0)
+    }
+}
+
+impl FromValue for Status {
+    fn from_value(v: &Value) -> Option<Self> {
+        match v {
+            Value::Status(s) => Some(Status(*s)),
+            _ => None,
+        }
+    }
+}
+
+impl ToValue for () {
+    fn to_value(&self) -> Value {
+        Value::Unit
+    }
+}
+
+impl FromValue for () {
+    fn from_value(v: &Value) -> Option<Self> {
+        matches!(v, Value::Unit).then_some(())
+    }
+}
+
+impl<T: ToValue, const N: usize> ToValue for [T; N] {
+    fn to_value(&self) -> Value {
+        Value::Array(self.iter().map(ToValue::to_value).collect())
+    }
+}
+
+impl<T: FromValue, const N: usize> FromValue for [T; N] {
+    fn from_value(v: &Value) -> Option<Self> {
+        let Value::Array(items) = v else {
+            return None;
+        };
+        let items: Vec<T> = items.iter().map(T::from_value).collect::<Option<_>>()?;
+        items.try_into().ok()
+    }
+}
+
+/// A controller's command enum seen by name: built from a verb name and
+/// arguments, taken apart into a verb id and arguments.
+pub trait DrivenCommand: Sized {
+    /// The command `verb(args…)`; an error names what does not fit.
+    fn from_parts(verb: &str, args: &[Value]) -> Result<Self, DriveError>;
+    /// The verb id and the arguments in declaration order.
+    fn parts(&self) -> (VerbId, Vec<Value>);
+}
+
+/// A name or value the driven controller does not accept.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum DriveError {
+    /// The controller has nothing of this kind with this name.
+    #[error("`{controller}` has no {kind} `{name}`")]
+    Unknown {
+        /// The controller.
+        controller: String,
+        /// `verb`, `buffer`, `hook` or `subordinate`.
+        kind: &'static str,
+        /// The name asked for.
+        name: String,
+    },
+    /// A value of the wrong shape or range.
+    #[error("`{controller}`: {what}: a value of another type")]
+    Type {
+        /// The controller.
+        controller: String,
+        /// What the value was for (`AHEAD.speed`, `ship`, …).
+        what: String,
+    },
+    /// A verb given the wrong number of arguments.
+    #[error("`{controller}`: {verb} takes {expected} argument(s), got {got}")]
+    Arity {
+        /// The controller.
+        controller: String,
+        /// The verb.
+        verb: String,
+        /// Its parameter count.
+        expected: usize,
+        /// The count given.
+        got: usize,
+    },
+}
+
+/// The `index`-th argument of `verb`, typed. For generated `from_parts`.
+pub fn arg<T: FromValue>(
+    controller: &str,
+    verb: &str,
+    param: &str,
+    args: &[Value],
+    index: usize,
+) -> Result<T, DriveError> {
+    args.get(index)
+        .and_then(T::from_value)
+        .ok_or_else(|| DriveError::Type {
+            controller: controller.to_string(),
+            what: format!("{verb}.{param}"),
+        })
+}
+
+/// `verb` must have exactly `expected` arguments. For generated `from_parts`.
+pub fn arity(
+    controller: &str,
+    verb: &str,
+    args: &[Value],
+    expected: usize,
+) -> Result<(), DriveError> {
+    if args.len() == expected {
+        Ok(())
+    } else {
+        Err(DriveError::Arity {
+            controller: controller.to_string(),
+            verb: verb.to_string(),
+            expected,
+            got: args.len(),
+        })
+    }
+}
+
+/// `name` is not one of `controller`'s `kind`s.
+pub fn unknown(controller: &str, kind: &'static str, name: &str) -> DriveError {
+    DriveError::Unknown {
+        controller: controller.to_string(),
+        kind,
+        name: name.to_string(),
+    }
+}
+
+/// `value` typed for `what`, or a [`DriveError::Type`].
+pub fn typed<T: FromValue>(controller: &str, what: &str, value: &Value) -> Result<T, DriveError> {
+    T::from_value(value).ok_or_else(|| DriveError::Type {
+        controller: controller.to_string(),
+        what: what.to_string(),
+    })
+}
+
+/// A command a cycle sent to a subordinate.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Sent {
+    /// The subordinate, by its position in the controller's `subordinates`.
+    pub sub: u16,
+    /// The verb, by its position in the subordinate's commands.
+    pub verb: VerbId,
+    /// The arguments in declaration order.
+    pub args: Vec<Value>,
+    /// The serial it was sent with.
+    pub serial: u32,
+}
+
+/// What one cycle did and left behind.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Record {
+    /// The cycle (0 first).
+    pub cycle: u64,
+    /// The verb of the command being (or last) executed; `None` before the first.
+    pub verb: Option<VerbId>,
+    /// The row that fired, if one did.
+    pub fired: Option<RowId>,
+    /// The plan's state after the cycle.
+    pub state: StateId,
+    /// The status after the cycle.
+    pub status: Status,
+    /// The error code after the cycle.
+    pub error: ErrorCode,
+    /// Commands sent to subordinates this cycle, in subordinate order.
+    pub sent: Vec<Sent>,
+    /// The controller's vars after the cycle, in declaration order.
+    pub vars: Vec<Value>,
+    /// Its `writes` buffers after the cycle, in declaration order.
+    pub writes: Vec<Value>,
+}
+
+/// One controller driven alone. Names are as written in the plans.
+pub trait Driven {
+    /// The controller's name.
+    fn name(&self) -> &str;
+    /// The supervisor writes a new command (the next serial), read at the
+    /// next cycle. Returns the serial.
+    fn command(&mut self, verb: &str, args: &[Value]) -> Result<u32, DriveError>;
+    /// The world writes `reads` buffer `buffer`; the next cycle reads it.
+    fn set_read(&mut self, buffer: &str, value: &Value) -> Result<(), DriveError>;
+    /// From now on hook `hook` returns `value` (until set again). Before it
+    /// is set a hook returns its type's zero.
+    fn set_hook(&mut self, hook: &str, value: &Value) -> Result<(), DriveError>;
+    /// Subordinate `sub` writes its status buffer (a new generation) before
+    /// the next cycle. A subordinate not written is silent: its status
+    /// goes stale.
+    fn write_sub_status(&mut self, sub: &str, status: StatusBuffer) -> Result<(), DriveError>;
+    /// The serial of the last command this controller sent `sub` (0: none).
+    fn last_sent(&self, sub: &str) -> Result<u32, DriveError>;
+    /// One control cycle.
+    fn cycle(&mut self) -> Record;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn integers_refuse_values_out_of_their_range() {
+        assert_eq!(u8::from_value(&Value::Int(255)), Some(255));
+        assert_eq!(u8::from_value(&Value::Int(256)), None);
+        assert_eq!(i8::from_value(&Value::Int(-129)), None);
+        assert_eq!(i64::from_value(&Value::Float(1.0)), None);
+    }
+
+    #[test]
+    fn arrays_round_trip_and_check_their_length() {
+        let a = [1.5f32, -2.0, 0.25];
+        let v = a.to_value();
+        assert_eq!(<[f32; 3]>::from_value(&v), Some(a));
+        assert_eq!(<[f32; 2]>::from_value(&v), None);
+    }
+
+    #[test]
+    fn f32_values_round_to_f32() {
+        assert_eq!(f32::from_value(&Value::Float(0.1)), Some(0.1f32));
+        assert_eq!(0.1f32.to_value(), Value::Float(f64::from(0.1f32)));
+    }
+
+    #[test]
+    fn errors_name_the_controller_and_the_name() {
+        assert_eq!(
+            unknown("PR", "hook", "nope").to_string(),
+            "`PR` has no hook `nope`"
+        );
+        let e = arity("PR", "AHEAD", &[], 1).unwrap_err();
+        assert_eq!(e.to_string(), "`PR`: AHEAD takes 1 argument(s), got 0");
+        let e = arg::<f64>("PR", "AHEAD", "speed", &[Value::Bool(true)], 0).unwrap_err();
+        assert_eq!(e.to_string(), "`PR`: AHEAD.speed: a value of another type");
+    }
+}

@@ -742,7 +742,7 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
         Ok(())
     }
 
-    fn last_sent(&self, sub: &str) -> Result<u32, rcs_runtime::driver::DriveError> {
+    fn last_sent(&mut self, sub: &str) -> Result<u32, rcs_runtime::driver::DriveError> {
         Ok(self.interp.last_sent(self.sub_index(sub)?))
     }
 

@@ -173,15 +173,15 @@ pub trait DrivenCommand: Sized {
 }
 
 /// A name or value the driven controller does not accept.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error, Serialize, Deserialize)]
 pub enum DriveError {
     /// The controller has nothing of this kind with this name.
     #[error("`{controller}` has no {kind} `{name}`")]
     Unknown {
         /// The controller.
         controller: String,
-        /// `verb`, `buffer`, `hook` or `subordinate`.
-        kind: &'static str,
+        /// `verb`, `read buffer`, `hook` or `subordinate`.
+        kind: String,
         /// The name asked for.
         name: String,
     },
@@ -243,10 +243,10 @@ pub fn arity(
 }
 
 /// `name` is not one of `controller`'s `kind`s.
-pub fn unknown(controller: &str, kind: &'static str, name: &str) -> DriveError {
+pub fn unknown(controller: &str, kind: &str, name: &str) -> DriveError {
     DriveError::Unknown {
         controller: controller.to_string(),
-        kind,
+        kind: kind.to_string(),
         name: name.to_string(),
     }
 }
@@ -273,7 +273,7 @@ pub struct Sent {
 }
 
 /// What one cycle did and left behind.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Record {
     /// The cycle (0 first).
     pub cycle: u64,
@@ -312,9 +312,263 @@ pub trait Driven {
     /// goes stale.
     fn write_sub_status(&mut self, sub: &str, status: StatusBuffer) -> Result<(), DriveError>;
     /// The serial of the last command this controller sent `sub` (0: none).
-    fn last_sent(&self, sub: &str) -> Result<u32, DriveError>;
+    fn last_sent(&mut self, sub: &str) -> Result<u32, DriveError>;
     /// One control cycle.
     fn cycle(&mut self) -> Record;
+}
+
+/// One request of the driver protocol: [`serve`] reads them as JSON lines
+/// and answers each with one [`Response`] line; [`Remote`] writes them.
+/// This is how `rcsc test --backend compiled` drives generated code that
+/// lives in a separate process (a small crate rcsc builds around it).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Request {
+    /// Replace the driven controller by a fresh `controller` of plan set
+    /// number `set` (an index into the server's factories).
+    New {
+        /// The plan set.
+        set: usize,
+        /// The controller's name.
+        controller: String,
+    },
+    /// [`Driven::command`].
+    Command {
+        /// The verb.
+        verb: String,
+        /// Its arguments.
+        args: Vec<Value>,
+    },
+    /// [`Driven::set_read`].
+    SetRead {
+        /// The buffer.
+        buffer: String,
+        /// Its value.
+        value: Value,
+    },
+    /// [`Driven::set_hook`].
+    SetHook {
+        /// The hook.
+        hook: String,
+        /// What it returns.
+        value: Value,
+    },
+    /// [`Driven::write_sub_status`].
+    WriteSubStatus {
+        /// The subordinate.
+        sub: String,
+        /// The status buffer it writes.
+        status: StatusBuffer,
+    },
+    /// [`Driven::last_sent`].
+    LastSent {
+        /// The subordinate.
+        sub: String,
+    },
+    /// [`Driven::cycle`].
+    Cycle,
+}
+
+/// The answer to one [`Request`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Response {
+    /// Done, nothing to return.
+    Done,
+    /// A serial number (`Command`, `LastSent`).
+    Serial(u32),
+    /// What the cycle did.
+    Record(Record),
+    /// The driven controller refused a name or value.
+    Refused(DriveError),
+    /// The request could not be served at all (no such plan set or
+    /// controller, no controller yet, a malformed line).
+    Failed(String),
+}
+
+/// Makes a fresh generated controller by name; `None`: no such controller.
+/// The generated `new_driver` of each plan set has this type.
+pub type Factory = fn(&str) -> Option<Result<Box<dyn Driven>, crate::SetupError>>;
+
+/// Serve the driver protocol: one [`Response`] line for each [`Request`]
+/// line of `input`, until `input` ends. `sets[i]` makes the controllers of
+/// plan set `i`.
+pub fn serve(
+    sets: &[Factory],
+    input: impl std::io::BufRead,
+    mut output: impl std::io::Write,
+) -> std::io::Result<()> {
+    let mut driven: Option<Box<dyn Driven>> = None;
+    for line in input.lines() {
+        let line = line?;
+        let response = match serde_json::from_str::<Request>(&line) {
+            Err(e) => Response::Failed(format!("malformed request: {e}")),
+            Ok(Request::New { set, controller }) => {
+                match sets.get(set).map(|make| make(&controller)) {
+                    None => Response::Failed(format!("no plan set number {set}")),
+                    Some(None) => Response::Failed(format!("no controller `{controller}`")),
+                    Some(Some(Err(e))) => {
+                        Response::Failed(format!("setting up `{controller}`: {e}"))
+                    }
+                    Some(Some(Ok(d))) => {
+                        driven = Some(d);
+                        Response::Done
+                    }
+                }
+            }
+            Ok(request) => match driven.as_deref_mut() {
+                None => Response::Failed("no controller yet: send `New` first".to_string()),
+                Some(d) => answer(d, request),
+            },
+        };
+        let text = serde_json::to_string(&response).map_err(std::io::Error::other)?;
+        writeln!(output, "{text}")?;
+        output.flush()?;
+    }
+    Ok(())
+}
+
+fn answer(d: &mut dyn Driven, request: Request) -> Response {
+    let done = |r: Result<(), DriveError>| r.map_or_else(Response::Refused, |()| Response::Done);
+    let serial = |r: Result<u32, DriveError>| r.map_or_else(Response::Refused, Response::Serial);
+    match request {
+        Request::New { .. } => Response::Failed("unexpected `New`".to_string()),
+        Request::Command { verb, args } => serial(d.command(&verb, &args)),
+        Request::SetRead { buffer, value } => done(d.set_read(&buffer, &value)),
+        Request::SetHook { hook, value } => done(d.set_hook(&hook, &value)),
+        Request::WriteSubStatus { sub, status } => done(d.write_sub_status(&sub, status)),
+        Request::LastSent { sub } => serial(d.last_sent(&sub)),
+        Request::Cycle => Response::Record(d.cycle()),
+    }
+}
+
+/// A controller driven through the protocol, in another process (the
+/// client side of [`serve`]). A broken connection or a refused request is
+/// kept in [`Remote::failure`]; the calls then return empty answers.
+#[derive(Debug)]
+pub struct Remote<R, W> {
+    input: R,
+    output: W,
+    name: String,
+    failure: Option<String>,
+}
+
+impl<R: std::io::BufRead, W: std::io::Write> Remote<R, W> {
+    /// Ask the server for a fresh `controller` of plan set `set`.
+    pub fn open(input: R, output: W, set: usize, controller: &str) -> Result<Self, String> {
+        let mut me = Remote {
+            input,
+            output,
+            name: controller.to_string(),
+            failure: None,
+        };
+        match me.call(&Request::New {
+            set,
+            controller: controller.to_string(),
+        }) {
+            Some(Response::Done) => Ok(me),
+            _ => Err(me
+                .failure
+                .unwrap_or_else(|| "unexpected answer".to_string())),
+        }
+    }
+
+    /// Give the connection back (to open the next controller on it).
+    pub fn into_parts(self) -> (R, W) {
+        (self.input, self.output)
+    }
+
+    /// Why the connection failed, if it did.
+    pub fn failure(&self) -> Option<&str> {
+        self.failure.as_deref()
+    }
+
+    fn call(&mut self, request: &Request) -> Option<Response> {
+        if self.failure.is_some() {
+            return None;
+        }
+        let result = (|| -> Result<Response, String> {
+            let text = serde_json::to_string(request).map_err(|e| e.to_string())?;
+            writeln!(self.output, "{text}").map_err(|e| e.to_string())?;
+            self.output.flush().map_err(|e| e.to_string())?;
+            let mut line = String::new();
+            if self.input.read_line(&mut line).map_err(|e| e.to_string())? == 0 {
+                return Err("the driver process ended".to_string());
+            }
+            serde_json::from_str(&line).map_err(|e| format!("malformed answer: {e}"))
+        })();
+        match result {
+            Ok(Response::Failed(reason)) => {
+                self.failure = Some(reason);
+                None
+            }
+            Ok(r) => Some(r),
+            Err(reason) => {
+                self.failure = Some(reason);
+                None
+            }
+        }
+    }
+
+    fn unit(&mut self, request: &Request) -> Result<(), DriveError> {
+        match self.call(request) {
+            Some(Response::Refused(e)) => Err(e),
+            _ => Ok(()),
+        }
+    }
+
+    fn serial(&mut self, request: &Request) -> Result<u32, DriveError> {
+        match self.call(request) {
+            Some(Response::Serial(n)) => Ok(n),
+            Some(Response::Refused(e)) => Err(e),
+            _ => Ok(0),
+        }
+    }
+}
+
+impl<R: std::io::BufRead, W: std::io::Write> Driven for Remote<R, W> {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn command(&mut self, verb: &str, args: &[Value]) -> Result<u32, DriveError> {
+        self.serial(&Request::Command {
+            verb: verb.to_string(),
+            args: args.to_vec(),
+        })
+    }
+
+    fn set_read(&mut self, buffer: &str, value: &Value) -> Result<(), DriveError> {
+        self.unit(&Request::SetRead {
+            buffer: buffer.to_string(),
+            value: value.clone(),
+        })
+    }
+
+    fn set_hook(&mut self, hook: &str, value: &Value) -> Result<(), DriveError> {
+        self.unit(&Request::SetHook {
+            hook: hook.to_string(),
+            value: value.clone(),
+        })
+    }
+
+    fn write_sub_status(&mut self, sub: &str, status: StatusBuffer) -> Result<(), DriveError> {
+        self.unit(&Request::WriteSubStatus {
+            sub: sub.to_string(),
+            status,
+        })
+    }
+
+    fn last_sent(&mut self, sub: &str) -> Result<u32, DriveError> {
+        self.serial(&Request::LastSent {
+            sub: sub.to_string(),
+        })
+    }
+
+    fn cycle(&mut self) -> Record {
+        match self.call(&Request::Cycle) {
+            Some(Response::Record(r)) => r,
+            _ => Record::default(),
+        }
+    }
 }
 
 #[cfg(test)]

@@ -338,7 +338,7 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
                 #sub_match_body
             }
 
-            fn last_sent(&self, sub: &str) -> Result<u32, #dv::DriveError> {
+            fn last_sent(&mut self, sub: &str) -> Result<u32, #dv::DriveError> {
                 #sub_last_body
             }
 

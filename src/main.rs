@@ -11,6 +11,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
+mod compiled;
+mod test_cmd;
+
 #[derive(Parser)]
 #[command(
     name = "rcsc",
@@ -39,6 +42,50 @@ enum Command {
     /// Print the validated intermediate representation, for other tools.
     #[command(after_help = IR_HELP)]
     Ir(IrArgs),
+    /// Run scenarios against the plans, on the interpreter or the generated code.
+    #[command(after_help = TEST_HELP)]
+    Test(TestArgs),
+}
+
+const TEST_HELP: &str = "\
+A scenario (*.scenario.yaml) drives one controller alone: it plays the
+supervisor's commands, the subordinates' answers, the buffers the controller
+reads and the results of its hooks, and says after each step which row
+fired and what state, status, vars, writes and sent commands to expect.
+
+Scenarios are found under `scenarios/` beside each plan set's rcs.yaml (or
+its .rcs files), or named on the command line (a scenario named alone tests
+the plan set above its `scenarios/` folder). The plans are checked first;
+an error stops the run (exit status 1).
+
+Each scenario prints `ok` or `FAILED`; a failure names the file and line of
+the step, expected against actual, and the rows fired so far. The run ends
+with `N passed, N failed`; any failure exits with status 1.
+
+`--backend compiled` runs the same scenarios on the generated Rust: rcsc
+writes a small driver crate under TARGET/rcsc/ and builds it with cargo
+(offline, once; later runs rebuild only what changed).
+
+Examples:
+  rcsc test plans/submarine
+  rcsc test plans/submarine --backend compiled --coverage
+  rcsc test plans/submarine/scenarios/pr_ahead_servo_loop.scenario.yaml";
+
+#[derive(Args)]
+struct TestArgs {
+    /// Plan sets, scenario files (*.scenario.yaml) or scenarios/ folders [default: .]
+    paths: Vec<PathBuf>,
+    /// What runs the scenarios.
+    #[arg(long, value_enum, default_value_t = test_cmd::Backend::Interp)]
+    backend: test_cmd::Backend,
+    /// After the run, list per plan the rows no scenario fired.
+    #[arg(long)]
+    coverage: bool,
+    /// Where the compiled backend builds its driver [default: $CARGO_TARGET_DIR or ./target]
+    #[arg(long, value_name = "DIR")]
+    target_dir: Option<PathBuf>,
+    #[command(flatten)]
+    common: Common,
 }
 
 const MAIN_HELP: &str = "\
@@ -270,6 +317,115 @@ fn main() -> ExitCode {
         Command::Build(args) => build(args),
         Command::Graph(args) => graph(args),
         Command::Ir(args) => ir(args),
+        Command::Test(args) => test(args),
+    }
+}
+
+fn test(args: TestArgs) -> ExitCode {
+    let start = Instant::now();
+    let status = Status {
+        color: args.common.color(),
+        quiet: args.common.quiet,
+    };
+    let targets = match test_cmd::targets(args.paths) {
+        Ok(t) => t,
+        Err(reason) => return fail(reason),
+    };
+    let sets = match rcs_dsl::load_paths(&targets.plan_paths) {
+        Ok(sets) => sets,
+        Err(e) => return fail(e),
+    };
+    let per_set = match test_cmd::assign(&sets, &targets.scenarios) {
+        Ok(p) => p,
+        Err(reason) => return fail(reason),
+    };
+    let options = args.common.options();
+    let mut counts = Counts::default();
+    let mut irs = Vec::with_capacity(sets.len());
+    for set in &sets {
+        let checked = rcs_dsl::check(set, &options);
+        print_diagnostics(set, &checked, &args.common, false, &mut counts);
+        irs.push(checked.ir);
+    }
+    print_summary(&args.common, &counts);
+    let irs: Vec<_> = irs.into_iter().flatten().collect();
+    if counts.errors > 0 || irs.len() != sets.len() {
+        return ExitCode::from(1);
+    }
+
+    let mut driver = None;
+    if args.backend == test_cmd::Backend::Compiled {
+        let target = args
+            .target_dir
+            .or_else(|| std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from))
+            .unwrap_or_else(|| PathBuf::from("target"));
+        let refs: Vec<&rcs_dsl::ir::Ir> = irs.iter().collect();
+        match compiled::build(&refs, &target, &test_cmd::status_fn(&status)) {
+            Ok(d) => driver = Some(d),
+            Err(reason) => return fail(reason),
+        }
+    }
+
+    let (mut passed, mut failed) = (0, 0);
+    let mut reports = Vec::new();
+    let mut coverage = String::new();
+    let (mut hit, mut all) = (0, 0);
+    for (i, (set, ir)) in sets.iter().zip(&irs).enumerate() {
+        let loaded: Vec<_> = per_set[i].iter().map(|p| test_cmd::load(ir, p)).collect();
+        status.line(
+            "Running",
+            format!(
+                "{} of {} on {}",
+                plural(loaded.len(), "scenario"),
+                ir.system,
+                args.backend.describe()
+            ),
+        );
+        let mut fired = test_cmd::Fired::new();
+        let remote = driver.as_mut().map(|d| (d, i));
+        let results = match test_cmd::run_set(ir, &loaded, remote, &mut fired) {
+            Ok(r) => r,
+            Err(reason) => return fail(reason),
+        };
+        for r in results {
+            match r.failure {
+                None => {
+                    passed += 1;
+                    println!("test {} ... ok", r.path);
+                }
+                Some(report) => {
+                    failed += 1;
+                    println!("test {} ... FAILED", r.path);
+                    reports.push(report);
+                }
+            }
+        }
+        if args.coverage {
+            let (text, h, a) = test_cmd::coverage(set, ir, &fired);
+            coverage.push_str(&format!("\ncoverage of {}:\n{text}", ir.system));
+            hit += h;
+            all += a;
+        }
+    }
+    if !reports.is_empty() {
+        println!("\nfailures:\n");
+        for r in &reports {
+            println!("{r}");
+        }
+    }
+    if args.coverage {
+        print!("{coverage}");
+        println!("rows fired: {hit}/{all}\n");
+    }
+    status.line(
+        "Finished",
+        format!("in {:.2}s", start.elapsed().as_secs_f64()),
+    );
+    println!("{passed} passed, {failed} failed");
+    if failed > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
     }
 }
 

@@ -8,7 +8,8 @@
 //! - `docs/ahead.svg`, the state graph shown in the README, is what
 //!   `rcsc graph plans/submarine --plan PR.AHEAD --format svg` draws today
 //!   (`UPDATE_DOCS=1 cargo test --test docs` rewrites it);
-//! - the README gives the two commands of the project.
+//! - the README gives the two commands of the project, and its example
+//!   scenario passes on the submarine plans.
 
 use rcs_dsl::lint::Lint;
 use rcs_dsl::render::{self, Format};
@@ -203,6 +204,33 @@ fn the_readme_gives_the_two_commands() {
         readme.contains("docs/language.md"),
         "README.md links the reference"
     );
+}
+
+#[test]
+fn the_readme_scenario_passes() {
+    let readme = std::fs::read_to_string("README.md").unwrap();
+    let scenarios: Vec<Block> = blocks(&readme)
+        .into_iter()
+        .filter(|b| b.lang == "yaml" && b.text.contains("controller:"))
+        .collect();
+    assert_eq!(scenarios.len(), 1, "README.md shows one scenario");
+    let dir = std::env::temp_dir().join(format!("rcsc-docs-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("readme.scenario.yaml");
+    std::fs::write(&file, &scenarios[0].text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_rcsc"))
+        .args(["test", "plans/submarine"])
+        .arg(&file)
+        .env("NO_COLOR", "1")
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && stdout.ends_with("1 passed, 0 failed\n"),
+        "README.md:{}: the scenario fails:\n{stdout}",
+        scenarios[0].line
+    );
+    std::fs::remove_dir_all(dir).ok();
 }
 
 /// SVG text without what depends on the Graphviz build (its version comment).

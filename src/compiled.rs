@@ -1,0 +1,218 @@
+//! `rcsc test --backend compiled`: the generated Rust of the plan sets,
+//! with its scenario driver, built into a small crate under the target
+//! folder and run as a child process that serves
+//! `rcs_runtime::driver`'s protocol. The scenarios themselves are run by
+//! the same runner as on the interpreter (`rcs_dsl::scenario::run_on`),
+//! through a `Remote` per controller, so both backends are held to one
+//! reading of every scenario.
+//!
+//! The crate (`<target>/rcsc/driver/`) depends only on `rcs-runtime`; it is
+//! rewritten only where its files change and built by cargo with
+//! `--offline` first, so after the first build a run costs a second or
+//! two and needs no network.
+
+use rcs_dsl::ir::Ir;
+use std::io::{BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
+
+/// The package name, also the binary's.
+const PACKAGE: &str = "rcsc-scenario-driver";
+
+/// The lock file of the workspace rcsc was built in: the driver crate
+/// starts from it so that cargo resolves the same versions offline.
+const WORKSPACE_LOCK: &str = include_str!("../Cargo.lock");
+
+/// A running driver process.
+pub struct Driver {
+    child: Child,
+    /// `Some` between controllers; a `Remote` borrows the pipes while open.
+    pipes: Option<(BufReader<ChildStdout>, ChildStdin)>,
+}
+
+/// A controller of the driver process, for one scenario.
+pub type Remote = rcs_runtime::driver::Remote<BufReader<ChildStdout>, ChildStdin>;
+
+impl Driver {
+    /// A fresh `controller` of plan set number `set` (in the order given to [`build`]).
+    pub fn open(&mut self, set: usize, controller: &str) -> Result<Remote, String> {
+        let (input, output) = self
+            .pipes
+            .take()
+            .ok_or("the driver connection was lost by an earlier failure")?;
+        Remote::open(input, output, set, controller)
+    }
+
+    /// Take the pipes back after a scenario.
+    pub fn close(&mut self, remote: Remote) {
+        self.pipes = Some(remote.into_parts());
+    }
+}
+
+impl Drop for Driver {
+    fn drop(&mut self) {
+        // Closing stdin ends the server's loop; wait so no zombie is left.
+        self.pipes = None;
+        let _ = self.child.wait();
+    }
+}
+
+/// Where `rcs-runtime` comes from: `RCSC_RUNTIME_PATH`, else the source
+/// tree rcsc was built from, else crates.io.
+fn runtime_dependency() -> String {
+    let local = std::env::var_os("RCSC_RUNTIME_PATH")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("rcs-runtime"));
+    if local.join("Cargo.toml").is_file() {
+        // TOML basic strings take `\` escapes; write the path with `/`.
+        let path = local.display().to_string().replace('\\', "/");
+        format!("{{ path = {path:?} }}")
+    } else {
+        format!("\"={}\"", env!("CARGO_PKG_VERSION"))
+    }
+}
+
+/// The driver crate's files for these plan sets (pure).
+fn crate_files(irs: &[&Ir]) -> Vec<rcs_codegen::OutputFile> {
+    let generated = rcs_codegen::GENERATED;
+    let mut files = vec![rcs_codegen::OutputFile {
+        path: "Cargo.toml".to_string(),
+        contents: format!(
+            "# {generated}: the scenario driver of `rcsc test --backend compiled`.\n\
+             [package]\nname = \"{PACKAGE}\"\nversion = \"0.0.0\"\nedition = \"2021\"\npublish = false\n\n\
+             [dependencies]\nrcs-runtime = {}\n\n\
+             # Its own workspace, wherever the target folder lives.\n[workspace]\n",
+            runtime_dependency()
+        ),
+    }];
+    let mut modules = String::new();
+    let mut factories = String::new();
+    for (i, ir) in irs.iter().enumerate() {
+        let rust = rcs_codegen::generate_with(ir, &rcs_codegen::Options { driver: true })
+            .into_iter()
+            .find(|f| f.path.starts_with("rust/"))
+            .expect("the generated Rust");
+        let file = format!("set_{i}.rs");
+        let system = rcs_codegen::ident::ident(&rcs_codegen::ident::snake(&ir.system));
+        modules.push_str(&format!("mod set_{i} {{\n    include!({file:?});\n}}\n"));
+        factories.push_str(&format!("        set_{i}::{system}::new_driver,\n"));
+        files.push(rcs_codegen::OutputFile {
+            path: format!("src/{file}"),
+            contents: rust.contents,
+        });
+    }
+    files.push(rcs_codegen::OutputFile {
+        path: "src/main.rs".to_string(),
+        contents: format!(
+            "// {generated}: serves rcs_runtime::driver's protocol on stdin/stdout.\n\
+             #![allow(dead_code)]\n{modules}\n\
+             fn main() {{\n    let sets: &[rcs_runtime::driver::Factory] = &[\n{factories}    ];\n    \
+             let served = rcs_runtime::driver::serve(sets, std::io::stdin().lock(), std::io::stdout().lock());\n    \
+             if let Err(e) = served {{\n        eprintln!(\"scenario driver: {{e}}\");\n        std::process::exit(2);\n    }}\n}}\n"
+        ),
+    });
+    files
+}
+
+/// Write, build and start the driver for these plan sets. `status` prints
+/// a progress line.
+pub fn build(irs: &[&Ir], target_dir: &Path, status: &dyn Fn(&str)) -> Result<Driver, String> {
+    let root = target_dir.join("rcsc");
+    let source = root.join("driver");
+    let build_dir = root.join("driver-target");
+    let report = rcs_codegen::writer::write_tree(&source, &crate_files(irs))
+        .map_err(|e| format!("writing the scenario driver: {e}"))?;
+    let lock = source.join("Cargo.lock");
+    if !lock.exists() {
+        std::fs::write(&lock, WORKSPACE_LOCK)
+            .map_err(|e| format!("cannot write {}: {e}", lock.display()))?;
+    }
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let run = |offline: bool| {
+        let mut cmd = Command::new(&cargo);
+        cmd.arg("build")
+            .arg("--quiet")
+            .arg("--manifest-path")
+            .arg(source.join("Cargo.toml"))
+            .arg("--target-dir")
+            .arg(&build_dir)
+            .env_remove("CARGO_TARGET_DIR")
+            .stdin(Stdio::null());
+        if offline {
+            cmd.arg("--offline");
+        }
+        cmd.output()
+    };
+    if !report.written.is_empty() || !binary(&build_dir).exists() {
+        status(&format!(
+            "scenario driver ({})",
+            rcs_dsl::load::display(&source)
+        ));
+    }
+    let mut out = run(true).map_err(|e| format!("cannot run cargo: {e}"))?;
+    if !out.status.success() {
+        // Offline resolution fails only when a crate is missing locally.
+        out = run(false).map_err(|e| format!("cannot run cargo: {e}"))?;
+    }
+    if !out.status.success() {
+        return Err(format!(
+            "building the scenario driver failed:\n{}",
+            String::from_utf8_lossy(&out.stderr).trim_end()
+        ));
+    }
+    let mut child = Command::new(binary(&build_dir))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .map_err(|e| format!("cannot start the scenario driver: {e}"))?;
+    let (Some(stdin), Some(stdout)) = (child.stdin.take(), child.stdout.take()) else {
+        return Err("the scenario driver has no pipes".to_string());
+    };
+    let mut stdin = stdin;
+    stdin.flush().map_err(|e| e.to_string())?;
+    Ok(Driver {
+        child,
+        pipes: Some((BufReader::new(stdout), stdin)),
+    })
+}
+
+fn binary(build_dir: &Path) -> PathBuf {
+    build_dir
+        .join("debug")
+        .join(format!("{PACKAGE}{}", std::env::consts::EXE_SUFFIX))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_crate_names_every_set_and_is_marked_generated() {
+        let set = rcs_dsl::PlanSet::from_texts(
+            "a",
+            [("a.rcs", "controller A {\n    command GO\n    plan GO {\n        *0 when new_command -> Done\n    }\n}\n")],
+            None,
+        );
+        let ir = rcs_dsl::check(&set, &rcs_dsl::Options::default())
+            .ir
+            .unwrap();
+        let files = crate_files(&[&ir, &ir]);
+        let paths: Vec<&str> = files.iter().map(|f| f.path.as_str()).collect();
+        assert_eq!(
+            paths,
+            ["Cargo.toml", "src/set_0.rs", "src/set_1.rs", "src/main.rs"]
+        );
+        assert!(files.iter().all(|f| f
+            .contents
+            .lines()
+            .next()
+            .unwrap()
+            .contains(rcs_codegen::GENERATED)));
+        let main = &files[3].contents;
+        assert!(main.contains("set_0::a::new_driver") && main.contains("set_1::a::new_driver"));
+        assert!(files[1]
+            .contents
+            .contains("impl ::rcs_runtime::driver::Driven for Driver"));
+    }
+}

@@ -1,0 +1,375 @@
+//! `rcsc test`: find the scenarios of the plan sets named, check the
+//! plans, run every scenario on the chosen backend (the reference
+//! interpreter, or the generated code through [`crate::compiled`]), report
+//! each like `cargo test` does, and optionally the rows no scenario fired.
+
+use crate::{compiled, Status};
+use rcs_dsl::ir::{CommandId, Ir, RowId};
+use rcs_dsl::scenario::{self, Outcome, Scenario};
+use rcs_dsl::source::SourceFile;
+use rcs_dsl::PlanSet;
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+/// Which code runs the scenarios.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Backend {
+    /// The reference interpreter of the IR (no compilation).
+    Interp,
+    /// The generated Rust, built into a driver crate under the target folder.
+    Compiled,
+}
+
+impl Backend {
+    pub fn describe(self) -> &'static str {
+        match self {
+            Backend::Interp => "the interpreter",
+            Backend::Compiled => "the generated code",
+        }
+    }
+}
+
+/// What to run: plan-set paths, and scenario files named explicitly.
+#[derive(Debug, Default, PartialEq)]
+pub struct Targets {
+    pub plan_paths: Vec<PathBuf>,
+    pub scenarios: Vec<PathBuf>,
+}
+
+/// Whether a path names a scenario file.
+fn is_scenario(path: &Path) -> bool {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy())
+        .unwrap_or_default();
+    name.ends_with(".scenario.yaml") || name.ends_with(".scenario.yml")
+}
+
+/// The `*.scenario.yaml` files of a folder, sorted.
+fn scenarios_in(dir: &Path) -> Result<Vec<PathBuf>, String> {
+    let entries = match std::fs::read_dir(dir) {
+        Ok(e) => e,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(format!("cannot read {}: {e}", rcs_dsl::load::display(dir))),
+    };
+    let mut out = Vec::new();
+    for entry in entries {
+        let path = entry
+            .map_err(|e| format!("cannot read {}: {e}", rcs_dsl::load::display(dir)))?
+            .path();
+        if path.is_file() && is_scenario(&path) {
+            out.push(path);
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// Split the command line into plan sets and scenarios. A `scenarios/`
+/// folder stands for its scenario files; a scenario named without any
+/// plan set tests the set it lives in (the folder above `scenarios/`, or
+/// the nearest folder with an `rcs.yaml`).
+pub fn targets(paths: Vec<PathBuf>) -> Result<Targets, String> {
+    let mut t = Targets::default();
+    for p in paths {
+        if is_scenario(&p) {
+            t.scenarios.push(p);
+        } else if p.is_dir() && p.file_name().is_some_and(|n| n == "scenarios") {
+            t.scenarios.extend(scenarios_in(&p)?);
+        } else {
+            t.plan_paths.push(p);
+        }
+    }
+    if t.plan_paths.is_empty() {
+        let mut homes = Vec::new();
+        for s in &t.scenarios {
+            let home = home_of(s).ok_or_else(|| {
+                format!(
+                    "cannot tell which plan set {} tests; name the plan set too (`rcsc test PLANS {}`)",
+                    rcs_dsl::load::display(s),
+                    rcs_dsl::load::display(s)
+                )
+            })?;
+            if !homes.contains(&home) {
+                homes.push(home);
+            }
+        }
+        t.plan_paths = homes;
+    }
+    if t.plan_paths.is_empty() {
+        t.plan_paths.push(PathBuf::from("."));
+    }
+    Ok(t)
+}
+
+/// The plan-set folder a scenario file belongs to.
+fn home_of(scenario: &Path) -> Option<PathBuf> {
+    let dir = scenario.parent()?;
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    if dir.file_name().is_some_and(|n| n == "scenarios") {
+        let up = dir.parent()?;
+        return Some(if up.as_os_str().is_empty() {
+            PathBuf::from(".")
+        } else {
+            up.to_path_buf()
+        });
+    }
+    dir.ancestors()
+        .find(|a| a.join("rcs.yaml").is_file())
+        .map(Path::to_path_buf)
+}
+
+/// The folder a plan set's `scenarios/` sits in.
+fn set_folder(set: &PlanSet) -> PathBuf {
+    if !set.root.is_empty() {
+        return PathBuf::from(&set.root);
+    }
+    // Loose files: the folder of the first one.
+    set.rcs_files
+        .first()
+        .and_then(|f| Path::new(&set.sources.get(*f).path).parent())
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("."))
+}
+
+fn same_place(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a == b,
+    }
+}
+
+/// Scenario files per plan set: those named for it, else its `scenarios/`.
+pub fn assign(sets: &[PlanSet], named: &[PathBuf]) -> Result<Vec<Vec<PathBuf>>, String> {
+    let folders: Vec<PathBuf> = sets.iter().map(set_folder).collect();
+    let mut per_set = vec![Vec::new(); sets.len()];
+    for s in named {
+        let home = home_of(s);
+        let i = match home
+            .as_ref()
+            .and_then(|h| folders.iter().position(|f| same_place(f, h)))
+        {
+            Some(i) => i,
+            None if sets.len() == 1 => 0,
+            None => {
+                return Err(format!(
+                    "{} is not under any of the plan sets named; run it with its own plan set",
+                    rcs_dsl::load::display(s)
+                ))
+            }
+        };
+        per_set[i].push(s.clone());
+    }
+    for (i, list) in per_set.iter_mut().enumerate() {
+        if list.is_empty() && named.is_empty() {
+            *list = scenarios_in(&folders[i].join("scenarios"))?;
+        }
+    }
+    Ok(per_set)
+}
+
+/// One scenario to run, or a file that could not be read as one.
+pub struct Loaded {
+    pub path: String,
+    pub scenario: Result<Scenario, (usize, String)>,
+}
+
+pub fn load(ir: &Ir, path: &Path) -> Loaded {
+    let shown = rcs_dsl::load::display(path);
+    let scenario = match std::fs::read_to_string(path) {
+        Err(e) => Err((0, format!("cannot read: {e}"))),
+        Ok(text) => {
+            let stem = path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            let stem = stem
+                .trim_end_matches(".yaml")
+                .trim_end_matches(".yml")
+                .trim_end_matches(".scenario")
+                .to_string();
+            scenario::parse(ir, &SourceFile::new(shown.clone(), text), &stem)
+                .map_err(|e| (e.line, e.message))
+        }
+    };
+    Loaded {
+        path: shown,
+        scenario,
+    }
+}
+
+/// The rows fired, cycle by cycle, with runs of one name shortened
+/// (`- ×200`), so a long wait reads as one item.
+fn fired_so_far(fired: &[String]) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    let mut i = 0;
+    while i < fired.len() {
+        let mut j = i;
+        while j < fired.len() && fired[j] == fired[i] {
+            j += 1;
+        }
+        parts.push(if j - i > 2 {
+            format!("{} ×{}", fired[i], j - i)
+        } else {
+            fired[i..j].join(", ")
+        });
+        i = j;
+    }
+    if parts.is_empty() {
+        "none (no cycle ran)".to_string()
+    } else {
+        parts.join(", ")
+    }
+}
+
+/// One scenario's result line and, if it failed, its report.
+pub struct ScenarioResult {
+    pub path: String,
+    pub failure: Option<String>,
+}
+
+/// The report of a failed scenario: file and line, expected against
+/// actual (one line each), and the rows fired so far.
+fn failure_report(path: &str, o: &Outcome) -> Option<String> {
+    let (line, report) = o.failure.as_ref()?;
+    let mut text = format!("{path}:{line}: scenario `{}` failed here\n", o.name);
+    for problem in report.lines() {
+        text.push_str(&format!("    {problem}\n"));
+    }
+    text.push_str(&format!(
+        "  rows fired so far: {}\n",
+        fired_so_far(&o.fired)
+    ));
+    Some(text)
+}
+
+/// Rows fired per (controller, verb, row) over a plan set's scenarios.
+pub type Fired = BTreeSet<(u32, CommandId, RowId)>;
+
+/// Run the loaded scenarios of one plan set. `remote`: the compiled
+/// backend's driver and this set's number in it.
+pub fn run_set(
+    ir: &Ir,
+    loaded: &[Loaded],
+    mut remote: Option<(&mut compiled::Driver, usize)>,
+    fired: &mut Fired,
+) -> Result<Vec<ScenarioResult>, String> {
+    let mut results = Vec::new();
+    for l in loaded {
+        let s = match &l.scenario {
+            Err((line, message)) => {
+                let at = if *line == 0 {
+                    l.path.clone()
+                } else {
+                    format!("{}:{line}", l.path)
+                };
+                results.push(ScenarioResult {
+                    path: l.path.clone(),
+                    failure: Some(format!("{at}: error: {message}\n")),
+                });
+                continue;
+            }
+            Ok(s) => s,
+        };
+        let outcome = match remote.as_mut() {
+            None => scenario::run(ir, s),
+            Some((driver, set)) => {
+                let name = &ir.controller(s.controller).name;
+                let mut r = driver.open(*set, name)?;
+                let outcome = scenario::run_on(ir, s, &mut r);
+                if let Some(reason) = r.failure() {
+                    return Err(format!("the scenario driver failed: {reason}"));
+                }
+                driver.close(r);
+                outcome
+            }
+        };
+        for (verb, row) in &outcome.rows {
+            fired.insert((s.controller.0, *verb, *row));
+        }
+        results.push(ScenarioResult {
+            path: l.path.clone(),
+            failure: failure_report(&l.path, &outcome),
+        });
+    }
+    Ok(results)
+}
+
+/// Per plan of the set: rows fired out of rows, and where each unfired row is.
+pub fn coverage(set: &PlanSet, ir: &Ir, fired: &Fired) -> (String, usize, usize) {
+    let mut text = String::new();
+    let (mut hit, mut all) = (0, 0);
+    for (ci, c) in ir.controllers.iter().enumerate() {
+        for (vi, k) in c.commands.iter().enumerate() {
+            let Some(pid) = k.plan else { continue };
+            let plan = &c.plans[pid.index()];
+            let missing: Vec<_> = plan
+                .rows
+                .iter()
+                .enumerate()
+                .filter(|(ri, _)| {
+                    !fired.contains(&(ci as u32, CommandId(vi as u32), RowId(*ri as u32)))
+                })
+                .map(|(_, r)| r)
+                .collect();
+            let n = plan.rows.len();
+            hit += n - missing.len();
+            all += n;
+            text.push_str(&format!(
+                "  {:<24} {}/{} rows\n",
+                format!("{}.{}", c.name, k.name),
+                n - missing.len(),
+                n
+            ));
+            for r in missing {
+                let file = set.sources.get(r.span.file);
+                let (line, col) = file.line_col(r.span.start as usize);
+                text.push_str(&format!(
+                    "      not fired: {:<10} {}:{line}:{col}\n",
+                    r.display_name(),
+                    file.path
+                ));
+            }
+        }
+    }
+    (text, hit, all)
+}
+
+/// Print a status line through the CLI's `Status`.
+pub fn status_fn(status: &Status) -> impl Fn(&str) + '_ {
+    move |m| status.line("Compiling", m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn long_runs_of_one_row_are_shortened() {
+        let f: Vec<String> = ["E0", "-", "-", "-", "-", "E2", "E3", "E3"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        assert_eq!(fired_so_far(&f), "E0, - ×4, E2, E3, E3");
+        assert_eq!(fired_so_far(&[]), "none (no cycle ran)");
+    }
+
+    #[test]
+    fn scenario_files_are_told_from_plan_paths() {
+        let t = targets(vec![
+            "plans/submarine".into(),
+            "x/scenarios/a.scenario.yaml".into(),
+        ])
+        .unwrap();
+        assert_eq!(t.plan_paths, [PathBuf::from("plans/submarine")]);
+        assert_eq!(t.scenarios, [PathBuf::from("x/scenarios/a.scenario.yaml")]);
+        // A scenario alone tests the set above its `scenarios/` folder.
+        let t = targets(vec!["x/scenarios/a.scenario.yaml".into()]).unwrap();
+        assert_eq!(t.plan_paths, [PathBuf::from("x")]);
+        assert!(targets(vec!["/nowhere/a.scenario.yaml".into()]).is_err());
+    }
+}

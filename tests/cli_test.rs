@@ -1,0 +1,226 @@
+//! `rcsc test` end to end: the project's scenarios pass on both backends
+//! with every row covered, failures read well and exit 1, scenario files
+//! that name things the plans lack are refused with their line, and
+//! coverage names the rows no scenario fired.
+
+mod common;
+
+use common::{rcsc, rcsc_in, scratch, text};
+use std::path::Path;
+
+fn scenario_count(set: &str) -> usize {
+    std::fs::read_dir(Path::new(set).join("scenarios"))
+        .expect("scenarios folder")
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .ends_with(".scenario.yaml")
+        })
+        .count()
+}
+
+/// Every `CTRL.VERB  n/m rows` line of a coverage report.
+fn coverage_lines(out: &str) -> Vec<(String, usize, usize)> {
+    out.lines()
+        .filter_map(|l| {
+            let l = l.trim();
+            let (name, rest) = l.split_once(' ')?;
+            let (frac, _) = rest.trim().split_once(" rows")?;
+            let (a, b) = frac.split_once('/')?;
+            Some((name.to_string(), a.parse().ok()?, b.parse().ok()?))
+        })
+        .collect()
+}
+
+fn assert_full_coverage(out: &str, plans: usize) {
+    let lines = coverage_lines(out);
+    assert_eq!(lines.len(), plans, "one line per plan:\n{out}");
+    for (name, fired, rows) in &lines {
+        assert_eq!(fired, rows, "{name}: not every row fired:\n{out}");
+    }
+    assert!(!out.contains("not fired"), "{out}");
+}
+
+#[test]
+fn the_project_scenarios_pass_on_the_interpreter_with_every_row_covered() {
+    let out = rcsc(&["test", "plans/submarine", "plans/figure13", "--coverage"]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{}", text(&out.stderr));
+    let n = scenario_count("plans/submarine") + scenario_count("plans/figure13");
+    assert!(n >= 30, "the plans have their scenarios");
+    assert_eq!(stdout.lines().filter(|l| l.ends_with("... ok")).count(), n);
+    assert_eq!(
+        stdout.lines().last(),
+        Some(&*format!("{n} passed, 0 failed"))
+    );
+    // SM 2 + PR 3 + TB 4 plans, GX 1.
+    assert_full_coverage(&stdout, 10);
+    assert!(
+        text(&out.stderr).contains("Running"),
+        "status lines on stderr"
+    );
+}
+
+#[test]
+fn a_wrong_expectation_fails_with_file_line_expected_actual_and_rows_so_far() {
+    let out = rcsc(&[
+        "test",
+        "plans/submarine",
+        "tests/data/scenarios/wrong_expectation.scenario.yaml",
+    ]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(stdout.contains("test tests/data/scenarios/wrong_expectation.scenario.yaml ... FAILED"));
+    assert!(
+        stdout.contains("tests/data/scenarios/wrong_expectation.scenario.yaml:10: scenario `wrong_expectation` failed here"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("    fired: expected E2, got none"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("rows fired so far: E0, -"), "{stdout}");
+    assert_eq!(stdout.lines().last(), Some("0 passed, 1 failed"));
+}
+
+const PLAN: &str = "\
+controller A {
+    reads tank: Level
+    command FILL
+    plan FILL {
+        E0: *0 when new_command -> S1
+        E1: S1 when tank.height > 10 -> Done
+        E2: S1 when state_cycles > 5 -> Error(TOO_SLOW)
+    }
+    error TOO_SLOW
+}
+buffer Level { height: i32 }
+";
+
+#[test]
+fn scenario_mistakes_are_refused_with_their_line() {
+    let dir = scratch(
+        "test-mistakes",
+        &[
+            ("a.rcs", PLAN),
+            (
+                "scenarios/bad_controller.scenario.yaml",
+                "controller: B\nsteps:\n  - command: FILL\n",
+            ),
+            (
+                "scenarios/bad_field.scenario.yaml",
+                "controller: A\nsteps:\n  - command: FILL\n  - reads: { tank: { depth: 3 } }\n",
+            ),
+            (
+                "scenarios/bad_row.scenario.yaml",
+                "controller: A\nsteps:\n  - command: FILL\n    expect: { fired: E7 }\n",
+            ),
+        ],
+    );
+    let out = rcsc_in(&dir, &["test"]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}{}", text(&out.stderr));
+    for (file, line, message) in [
+        ("bad_controller", 1, "unknown controller `B`"),
+        ("bad_field", 4, "has no field `depth`"),
+        ("bad_row", 3, "no row of `A` is called `E7`"),
+    ] {
+        let at = format!("scenarios/{file}.scenario.yaml:{line}: error: ");
+        let hit = stdout.lines().find(|l| l.contains(&at));
+        assert!(
+            hit.is_some_and(|l| l.contains(message)),
+            "{file}: {message}\n{stdout}"
+        );
+    }
+    assert_eq!(stdout.lines().last(), Some("0 passed, 3 failed"));
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn coverage_names_each_row_no_scenario_fired_with_its_place() {
+    let dir = scratch(
+        "test-coverage",
+        &[
+            ("a.rcs", PLAN),
+            (
+                "scenarios/fill.scenario.yaml",
+                "controller: A\nsteps:\n  - command: FILL\n    expect: { fired: E0, state: S1 }\n  - reads: { tank: { height: 11 } }\n    expect: { fired: E1, status: DONE }\n",
+            ),
+        ],
+    );
+    let out = rcsc_in(&dir, &["test", "--coverage"]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}");
+    assert!(stdout.contains("A.FILL"), "{stdout}");
+    assert_eq!(coverage_lines(&stdout), [("A.FILL".to_string(), 2, 3)]);
+    let missing: Vec<&str> = stdout.lines().filter(|l| l.contains("not fired")).collect();
+    assert_eq!(missing.len(), 1, "{stdout}");
+    assert!(
+        missing[0].contains("E2") && missing[0].contains("a.rcs:7:9"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("rows fired: 2/3"));
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn plans_with_errors_run_no_scenario_and_unplaceable_scenarios_are_usage_errors() {
+    let dir = scratch(
+        "test-errors",
+        &[
+            ("one/a.rcs", "controller A {\n    command GO\n    plan GO {\n        *0 when nope -> Done\n    }\n}\n"),
+            ("one/scenarios/s.scenario.yaml", "controller: A\nsteps:\n  - command: GO\n"),
+            ("two/a.rcs", PLAN),
+            ("loose.scenario.yaml", "controller: A\nsteps:\n  - command: FILL\n"),
+        ],
+    );
+    let out = rcsc_in(&dir, &["test", "one"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("error["),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(!text(&out.stdout).contains("passed"), "no scenario ran");
+
+    let out = rcsc_in(&dir, &["test", "one", "two", "loose.scenario.yaml"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("loose.scenario.yaml is not under any of the plan sets"));
+
+    let out = rcsc_in(&dir, &["test", "two", "missing.scenario.yaml"]);
+    assert_eq!(out.status.code(), Some(1), "an unreadable scenario fails");
+    assert!(text(&out.stdout).contains("missing.scenario.yaml: error: cannot read"));
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// Both backends in one test: the driver crate is built once (into
+/// cargo's per-test-suite temporary folder, kept between runs).
+#[test]
+fn the_compiled_backend_gives_the_same_results_as_the_interpreter() {
+    let target = Path::new(env!("CARGO_TARGET_TMPDIR")).join("rcsc-test-driver");
+    let target = target.to_str().unwrap();
+    let run = |backend: &str, args: &[&str]| {
+        let mut all = vec!["test", "--backend", backend, "--target-dir", target];
+        all.extend_from_slice(args);
+        let out = rcsc(&all);
+        (out.status.code(), text(&out.stdout), text(&out.stderr))
+    };
+    let sets = ["plans/submarine", "plans/figure13", "--coverage"];
+    let (code, compiled, stderr) = run("compiled", &sets);
+    assert_eq!(code, Some(0), "{compiled}{stderr}");
+    assert_full_coverage(&compiled, 10);
+    let (_, interp, _) = run("interp", &sets);
+    assert_eq!(compiled, interp, "identical reports on both backends");
+
+    let wrong = [
+        "plans/submarine",
+        "tests/data/scenarios/wrong_expectation.scenario.yaml",
+    ];
+    let (code, compiled, _) = run("compiled", &wrong);
+    assert_eq!(code, Some(1));
+    let (_, interp, _) = run("interp", &wrong);
+    assert_eq!(compiled, interp);
+    assert!(compiled.contains("fired: expected E2, got none"));
+}

@@ -50,6 +50,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .out_dir(&dest)
                 .graphs(false)
                 .driver(true)
+                .serde(rcs_codegen::SerdeDerives::Feature("serde".into()))
                 .compile(&path)?;
             let rust = std::fs::read_dir(dest.join("rust"))?
                 .map(|e| e.map(|e| e.path()))

@@ -127,6 +127,14 @@ impl Config {
         self
     }
 
+    /// serde derives on the generated buffer types and enums (default:
+    /// none); e.g. `SerdeDerives::Feature("serde".into())` for derives
+    /// behind your crate's `serde` feature.
+    pub fn serde(&mut self, derives: crate::SerdeDerives) -> &mut Config {
+        self.options.serde = derives;
+        self
+    }
+
     /// Whether to write the state graphs (`graphs/`) and tables (`tables/`)
     /// besides the Rust code (default: yes).
     pub fn graphs(&mut self, yes: bool) -> &mut Config {

@@ -37,6 +37,23 @@ pub struct Options {
     /// `rcs_runtime::driver::Driven` (for `rcsc test --backend compiled`
     /// and differential tests; not needed by a running system).
     pub driver: bool,
+    /// serde derives on the plan set's buffer types and enums.
+    pub serde: SerdeDerives,
+}
+
+/// Whether the generated buffer types and enums derive `serde::Serialize`
+/// and `serde::Deserialize` (through `::serde`, which the crate including
+/// the code must depend on).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum SerdeDerives {
+    /// No serde derives (the default).
+    #[default]
+    Off,
+    /// Always derive.
+    Always,
+    /// Derive when the including crate's cargo feature of this name is on
+    /// (`#[cfg_attr(feature = "…", derive(…))]`); declare the feature.
+    Feature(String),
 }
 
 /// Every output of one plan set, in a fixed order.

@@ -61,7 +61,16 @@ pub fn system_module(ir: &Ir, options: &crate::Options) -> String {
     } else {
         TokenStream::new()
     };
-    let types = types::module(ir, &names, conversions);
+    let serde = match &options.serde {
+        crate::SerdeDerives::Off => None,
+        crate::SerdeDerives::Always => {
+            Some(quote!(#[derive(::serde::Serialize, ::serde::Deserialize)]))
+        }
+        crate::SerdeDerives::Feature(name) => Some(
+            quote!(#[cfg_attr(feature = #name, derive(::serde::Serialize, ::serde::Deserialize))]),
+        ),
+    };
+    let types = types::module(ir, &names, serde.as_ref(), conversions);
     let controllers: Vec<TokenStream> = (0..ir.controllers.len())
         .map(|ci| {
             let extra = if options.driver {
@@ -100,4 +109,80 @@ pub fn system_module(ir: &Ir, options: &crate::Options) -> String {
         sources.join(", "),
         comments.restore(&printed)
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{Options, SerdeDerives};
+
+    fn rust(options: &Options) -> String {
+        let set = rcs_dsl::PlanSet::from_texts(
+            "t",
+            [(
+                "t.rcs",
+                "enum Mode { Off, On }\nbuffer Small { m: Mode, xs: [u8; 32] }\nbuffer Big { xs: [u8; 33] }\n\
+                 controller A {\n    reads small: Small\n    reads big: Big\n    command GO\n    plan GO {\n        \
+                 *0 when new_command && small.m == Mode::On && big.xs[0] == small.xs[0] -> Done\n    }\n}\n",
+            )],
+            None,
+        );
+        let ir = rcs_dsl::check(&set, &rcs_dsl::Options::default())
+            .ir
+            .expect("clean");
+        super::system_module(&ir, options)
+    }
+
+    /// The attribute line right above `pub <kind> <name>` (skipping docs).
+    fn attrs_of(text: &str, item: &str) -> Vec<String> {
+        let lines: Vec<&str> = text.lines().collect();
+        let at = lines
+            .iter()
+            .position(|l| l.trim_start().starts_with(item))
+            .unwrap_or_else(|| panic!("{item} in\n{text}"));
+        lines[..at]
+            .iter()
+            .rev()
+            .take_while(|l| l.trim_start().starts_with("#["))
+            .map(|l| l.trim().to_string())
+            .collect()
+    }
+
+    #[test]
+    fn serde_derives_follow_the_option_and_skip_arrays_serde_cannot_derive() {
+        let off = rust(&Options::default());
+        assert!(!off.contains("serde"));
+
+        let always = rust(&Options {
+            serde: SerdeDerives::Always,
+            ..Options::default()
+        });
+        let derive = "#[derive(::serde::Serialize, ::serde::Deserialize)]";
+        assert!(attrs_of(&always, "pub enum Mode").contains(&derive.to_string()));
+        assert!(attrs_of(&always, "pub struct Small").contains(&derive.to_string()));
+        assert!(!attrs_of(&always, "pub struct Big")
+            .iter()
+            .any(|a| a.contains("serde")));
+
+        let feature = rust(&Options {
+            serde: SerdeDerives::Feature("wire".into()),
+            ..Options::default()
+        });
+        assert!(attrs_of(&feature, "pub struct Small").contains(
+            &"#[cfg_attr(feature = \"wire\", derive(::serde::Serialize, ::serde::Deserialize))]"
+                .to_string()
+        ));
+    }
+
+    #[test]
+    fn the_driver_is_emitted_only_when_asked() {
+        let off = rust(&Options::default());
+        assert!(!off.contains("Driven") && !off.contains("new_driver"));
+        let on = rust(&Options {
+            driver: true,
+            ..Options::default()
+        });
+        assert!(on.contains("impl ::rcs_runtime::driver::Driven for Driver"));
+        assert!(on.contains("pub fn new_driver("));
+        assert!(on.contains("impl ::rcs_runtime::driver::FromValue for Big"));
+    }
 }

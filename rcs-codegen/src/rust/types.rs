@@ -6,15 +6,36 @@ use super::expr::{rust_type, zero};
 use super::names::Names;
 use proc_macro2::TokenStream;
 use quote::quote;
-use rcs_dsl::ir::Ir;
+use rcs_dsl::ir::{Ir, Type};
 
 fn docs(lines: &[String]) -> TokenStream {
     let lines = lines.iter().map(|l| format!(" {l}"));
     quote!(#(#[doc = #lines])*)
 }
 
-/// `extra`: more items for the module (the driver's conversions).
-pub(crate) fn module(ir: &Ir, names: &Names, extra: TokenStream) -> TokenStream {
+/// Whether serde can derive for a type: it implements arrays only up to 32.
+fn serde_derivable(ir: &Ir, t: &Type, depth: u32) -> bool {
+    match t {
+        Type::Array(elem, n) => *n <= 32 && serde_derivable(ir, elem, depth),
+        Type::Buffer(b) => {
+            depth < 64
+                && ir.buffer_types[b.index()]
+                    .fields
+                    .iter()
+                    .all(|f| serde_derivable(ir, &f.ty, depth + 1))
+        }
+        _ => true,
+    }
+}
+
+/// `serde`: the serde derive attribute, if asked for. `extra`: more items
+/// for the module (the driver's conversions).
+pub(crate) fn module(
+    ir: &Ir,
+    names: &Names,
+    serde: Option<&TokenStream>,
+    extra: TokenStream,
+) -> TokenStream {
     let enums = ir.enums.iter().enumerate().map(|(i, e)| {
         let n = &names.enums[i];
         let ty = &n.ty;
@@ -31,8 +52,10 @@ pub(crate) fn module(ir: &Ir, names: &Names, extra: TokenStream) -> TokenStream 
         });
         let ids = &n.variants;
         let texts: Vec<&str> = e.variants.iter().map(|v| v.name.as_str()).collect();
+        let serde = serde.into_iter();
         quote! {
             #d
+            #(#serde)*
             #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
             pub enum #ty { #(#variants),* }
             impl #ty {
@@ -66,8 +89,13 @@ pub(crate) fn module(ir: &Ir, names: &Names, extra: TokenStream) -> TokenStream 
                 },
             )
         };
+        // A buffer serde cannot derive for (an array over 32) goes without.
+        let serde = serde
+            .filter(|_| serde_derivable(ir, &Type::Buffer(rcs_dsl::ir::BufferTypeId(i as u32)), 0))
+            .into_iter();
         quote! {
             #d
+            #(#serde)*
             #[derive(Clone, Copy, Debug, #derive PartialEq)]
             pub struct #ty { #(#fdocs pub #fields: #tys),* }
             #default_impl

@@ -88,7 +88,11 @@ fn crate_files(irs: &[&Ir]) -> Vec<rcs_codegen::OutputFile> {
     let mut modules = String::new();
     let mut factories = String::new();
     for (i, ir) in irs.iter().enumerate() {
-        let rust = rcs_codegen::generate_with(ir, &rcs_codegen::Options { driver: true })
+        let options = rcs_codegen::Options {
+            driver: true,
+            ..rcs_codegen::Options::default()
+        };
+        let rust = rcs_codegen::generate_with(ir, &options)
             .into_iter()
             .find(|f| f.path.starts_with("rust/"))
             .expect("the generated Rust");

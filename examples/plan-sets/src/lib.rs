@@ -11,8 +11,7 @@ pub struct PlanSet {
     pub path: &'static str,
     /// A fresh generated controller of the set, by name, behind
     /// `rcs_runtime::driver::Driven` (`None`: no such controller).
-    pub new_driver:
-        fn(&str) -> Option<Result<Box<dyn rcs_runtime::driver::Driven>, rcs_runtime::SetupError>>,
+    pub new_driver: rcs_runtime::driver::Factory,
 }
 
 pub mod c_port;

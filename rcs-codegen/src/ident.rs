@@ -97,6 +97,17 @@ pub fn ident(name: &str) -> Ident {
     }
 }
 
+/// `prefix_name` for a generated name built from another (`in_ship`,
+/// `cmd_speed`): a raw identifier's `r#` is dropped, since the prefix
+/// already keeps the result clear of keywords.
+pub fn prefixed(prefix: &str, id: &Ident) -> Ident {
+    let name = id.to_string();
+    Ident::new(
+        &format!("{prefix}_{}", name.trim_start_matches("r#")),
+        Span::call_site(),
+    )
+}
+
 /// Convert names with `f` and make them distinct within one scope (and
 /// distinct from `reserved`), appending `_2`, `_3`, … on collision.
 pub fn distinct<'a>(

@@ -6,8 +6,10 @@
 use super::expr::{rust_type, zero, Code, Gen};
 use super::names::Names;
 use super::Comments;
+use crate::ident::prefixed;
+use proc_macro2::Ident;
 use proc_macro2::TokenStream;
-use quote::{format_ident, quote};
+use quote::quote;
 use rcs_dsl::ir::*;
 use rcs_dsl::pretty::Printer;
 
@@ -214,26 +216,19 @@ pub(crate) fn module(
     );
 
     // ---- data
-    let read_fields: Vec<_> = c
-        .reads
-        .iter()
-        .map(|b| n.buffers[b.index()].clone().expect("own buffer"))
-        .collect();
-    let read_tys: Vec<_> = c
-        .reads
-        .iter()
-        .map(|b| rust_type(names, &Type::Buffer(ir.buffers[b.index()].ty)))
-        .collect();
-    let write_fields: Vec<_> = c
-        .writes
-        .iter()
-        .map(|b| n.buffers[b.index()].clone().expect("own buffer"))
-        .collect();
-    let write_tys: Vec<_> = c
-        .writes
-        .iter()
-        .map(|b| rust_type(names, &Type::Buffer(ir.buffers[b.index()].ty)))
-        .collect();
+    let Wiring {
+        read_fields,
+        read_tys,
+        read_names,
+        read_handles,
+        write_fields,
+        write_tys,
+        write_names,
+        write_handles,
+        sub_names,
+        sub_modules,
+        sub_handles,
+    } = Wiring::new(ir, names, ci);
     let sub_fields = &n.subs;
     let var_fields = &n.vars;
     let var_tys: Vec<_> = c.vars.iter().map(|v| rust_type(names, &v.ty)).collect();
@@ -286,7 +281,7 @@ pub(crate) fn module(
             .filter(|(pi, _)| used.contains(&ParamId(*pi as u32)))
             .map(|(pi, _)| {
                 let field = &n.params[i][pi];
-                let local = format_ident!("cmd_{}", field.to_string().trim_start_matches("r#"));
+                let local = prefixed("cmd", field);
                 quote!(#field: #local)
             })
             .collect();
@@ -296,10 +291,7 @@ pub(crate) fn module(
             .enumerate()
             .filter(|(pi, _)| used.contains(&ParamId(*pi as u32)))
             .map(|(pi, _)| {
-                let local = format_ident!(
-                    "cmd_{}",
-                    n.params[i][pi].to_string().trim_start_matches("r#")
-                );
+                let local = prefixed("cmd", &n.params[i][pi]);
                 quote!(#local)
             })
             .collect();
@@ -338,39 +330,6 @@ pub(crate) fn module(
         }
     };
 
-    // ---- Global Memory handles
-    let read_handles: Vec<_> = read_fields
-        .iter()
-        .map(|f| format_ident!("in_{}", f.to_string().trim_start_matches("r#")))
-        .collect();
-    let write_handles: Vec<_> = write_fields
-        .iter()
-        .map(|f| format_ident!("out_{}", f.to_string().trim_start_matches("r#")))
-        .collect();
-    let sub_handles: Vec<_> = sub_fields
-        .iter()
-        .map(|f| format_ident!("sub_{}", f.to_string().trim_start_matches("r#")))
-        .collect();
-    let read_names: Vec<&str> = c
-        .reads
-        .iter()
-        .map(|b| ir.buffers[b.index()].name.as_str())
-        .collect();
-    let write_names: Vec<&str> = c
-        .writes
-        .iter()
-        .map(|b| ir.buffers[b.index()].name.as_str())
-        .collect();
-    let sub_names: Vec<&str> = c
-        .subordinates
-        .iter()
-        .map(|s| ir.controllers[s.index()].name.as_str())
-        .collect();
-    let sub_modules: Vec<_> = c
-        .subordinates
-        .iter()
-        .map(|s| &names.ctrls[s.index()].module)
-        .collect();
     let verb_count_lit = proc_macro2::Literal::usize_unsuffixed(verb_count);
     // The six steps of a cycle (SEMANTICS.md), as comments in the output.
     let step1 = comments.marker(
@@ -579,6 +538,72 @@ pub(crate) fn module(
     }
 }
 
+/// A controller's Global Memory wiring, in declaration order: its `reads`
+/// and `writes` buffers (field in `Reads`/`Writes`, Rust type, name in
+/// Global Memory, handle field) and its subordinates (name, module, handle
+/// field). The controller and its scenario driver both build on it.
+pub(crate) struct Wiring<'a> {
+    pub read_fields: Vec<Ident>,
+    pub read_tys: Vec<TokenStream>,
+    pub read_names: Vec<&'a str>,
+    pub read_handles: Vec<Ident>,
+    pub write_fields: Vec<Ident>,
+    pub write_tys: Vec<TokenStream>,
+    pub write_names: Vec<&'a str>,
+    pub write_handles: Vec<Ident>,
+    pub sub_names: Vec<&'a str>,
+    pub sub_modules: Vec<&'a Ident>,
+    pub sub_handles: Vec<Ident>,
+}
+
+impl<'a> Wiring<'a> {
+    pub fn new(ir: &'a Ir, names: &'a Names, ci: usize) -> Wiring<'a> {
+        let c = &ir.controllers[ci];
+        let n = &names.ctrls[ci];
+        let fields = |list: &[BufferId]| -> Vec<Ident> {
+            list.iter()
+                .map(|b| n.buffers[b.index()].clone().expect("own buffer"))
+                .collect()
+        };
+        let tys = |list: &[BufferId]| -> Vec<TokenStream> {
+            list.iter()
+                .map(|b| rust_type(names, &Type::Buffer(ir.buffers[b.index()].ty)))
+                .collect()
+        };
+        let gm_names = |list: &[BufferId]| -> Vec<&'a str> {
+            list.iter()
+                .map(|b| ir.buffers[b.index()].name.as_str())
+                .collect()
+        };
+        let handles = |prefix: &str, ids: &[Ident]| -> Vec<Ident> {
+            ids.iter().map(|f| prefixed(prefix, f)).collect()
+        };
+        let read_fields = fields(&c.reads);
+        let write_fields = fields(&c.writes);
+        Wiring {
+            read_handles: handles("in", &read_fields),
+            write_handles: handles("out", &write_fields),
+            sub_handles: handles("sub", &n.subs),
+            read_tys: tys(&c.reads),
+            write_tys: tys(&c.writes),
+            read_names: gm_names(&c.reads),
+            write_names: gm_names(&c.writes),
+            read_fields,
+            write_fields,
+            sub_names: c
+                .subordinates
+                .iter()
+                .map(|s| ir.controllers[s.index()].name.as_str())
+                .collect(),
+            sub_modules: c
+                .subordinates
+                .iter()
+                .map(|s| &names.ctrls[s.index()].module)
+                .collect(),
+        }
+    }
+}
+
 /// Whether a plan reads a subordinate's status.
 fn uses_subs(p: &Plan) -> bool {
     let mut used = false;
@@ -626,12 +651,7 @@ fn plan_fn(
         .enumerate()
         .filter(|(i, _)| used.contains(&ParamId(*i as u32)))
         .map(|(i, param)| {
-            let local = format_ident!(
-                "cmd_{}",
-                n.params[p.verb.index()][i]
-                    .to_string()
-                    .trim_start_matches("r#")
-            );
+            let local = prefixed("cmd", &n.params[p.verb.index()][i]);
             let ty = rust_type(names, &param.ty);
             quote!(#local: #ty)
         })

@@ -8,9 +8,10 @@
 //! None of this is on a running system's cycle path: it allocates, and it
 //! is meant for tests.
 
-use super::controller::derivable_default;
+use super::controller::{derivable_default, Wiring};
 use super::expr::{rust_type, zero};
 use super::names::Names;
+use crate::ident::prefixed;
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 use rcs_dsl::ir::{Ir, Type};
@@ -162,52 +163,20 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
     };
     let hook_names = c.hooks.iter().map(|h| h.name.as_str());
 
-    // ---- Driver
-    let read_fields: Vec<_> = c
-        .reads
-        .iter()
-        .map(|b| n.buffers[b.index()].clone().expect("own buffer"))
-        .collect();
-    let read_tys: Vec<_> = c
-        .reads
-        .iter()
-        .map(|b| rust_type(names, &Type::Buffer(ir.buffers[b.index()].ty)))
-        .collect();
-    let read_names: Vec<&str> = c
-        .reads
-        .iter()
-        .map(|b| ir.buffers[b.index()].name.as_str())
-        .collect();
-    let read_handles: Vec<_> = read_fields
-        .iter()
-        .map(|f| format_ident!("in_{}", f.to_string().trim_start_matches("r#")))
-        .collect();
-    let write_fields: Vec<_> = c
-        .writes
-        .iter()
-        .map(|b| n.buffers[b.index()].clone().expect("own buffer"))
-        .collect();
+    // ---- Driver: the controller's own wiring, plus the other ends of
+    // its subordinates' buffers (the driver plays them).
+    let Wiring {
+        read_tys,
+        read_names,
+        read_handles,
+        write_fields,
+        sub_names,
+        sub_modules,
+        ..
+    } = Wiring::new(ir, names, ci);
     let var_fields = &n.vars;
-    let sub_names: Vec<&str> = c
-        .subordinates
-        .iter()
-        .map(|s| ir.controllers[s.index()].name.as_str())
-        .collect();
-    let sub_modules: Vec<_> = c
-        .subordinates
-        .iter()
-        .map(|s| &names.ctrls[s.index()].module)
-        .collect();
-    let sub_cmd: Vec<_> = n
-        .subs
-        .iter()
-        .map(|f| format_ident!("cmd_{}", f.to_string().trim_start_matches("r#")))
-        .collect();
-    let sub_status: Vec<_> = n
-        .subs
-        .iter()
-        .map(|f| format_ident!("status_{}", f.to_string().trim_start_matches("r#")))
-        .collect();
+    let sub_cmd: Vec<_> = n.subs.iter().map(|f| prefixed("cmd", f)).collect();
+    let sub_status: Vec<_> = n.subs.iter().map(|f| prefixed("status", f)).collect();
     let sub_idx: Vec<u16> = (0..c.subordinates.len() as u16).collect();
     let doc = format!(
         " `{}` alone on its own Global Memory, driven by name (`rcs_runtime::driver::Driven`): the caller plays its supervisor, its subordinates, its `reads` buffers and its hooks.",

@@ -5,6 +5,7 @@
 //! implements the same rules.
 
 use super::names::Names;
+use crate::ident::prefixed;
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 use rcs_dsl::ast::{AssignOp, BinOp, UnOp};
@@ -181,12 +182,7 @@ impl Gen<'_> {
             ExprKind::StateCycles => Code::atom(quote!(self.bk.state_cycles())),
             ExprKind::PlanCycles => Code::atom(quote!(self.bk.plan_cycles())),
             ExprKind::CmdParam(c, p) => {
-                let local = format_ident!(
-                    "cmd_{}",
-                    self.cn().params[c.index()][p.index()]
-                        .to_string()
-                        .trim_start_matches("r#")
-                );
+                let local = prefixed("cmd", &self.cn().params[c.index()][p.index()]);
                 Code::atom(quote!(#local))
             }
             ExprKind::Var(v) => {
@@ -469,10 +465,7 @@ impl Gen<'_> {
                     .iter()
                     .position(|s| s == sub)
                     .expect("a subordinate");
-                let field = format_ident!(
-                    "sub_{}",
-                    self.cn().subs[i].to_string().trim_start_matches("r#")
-                );
+                let field = prefixed("sub", &self.cn().subs[i]);
                 let target = &self.names.ctrls[sub.index()];
                 let module = &target.module;
                 let variant = &target.commands[command.index()];

@@ -398,12 +398,7 @@ impl<'ir> Interpreter<'ir> {
                 sub, command, args, ..
             } => {
                 let args: Vec<Value> = args.iter().map(|a| self.eval(a, hooks)).collect();
-                let i = self
-                    .ctrl
-                    .subordinates
-                    .iter()
-                    .position(|s| s == sub)
-                    .expect("a subordinate");
+                let i = self.ctrl.subordinate_index(*sub).expect("a subordinate");
                 let serial = self.subs[i].link.next_command();
                 sent.push(Sent {
                     sub: *sub,
@@ -496,12 +491,7 @@ impl<'ir> Interpreter<'ir> {
                 hooks.call(&data, *h, &args)
             }
             ExprKind::Sub(c, prop) => {
-                let i = self
-                    .ctrl
-                    .subordinates
-                    .iter()
-                    .position(|s| s == c)
-                    .expect("a subordinate");
+                let i = self.ctrl.subordinate_index(*c).expect("a subordinate");
                 let v = self.subs[i].view;
                 match prop {
                     SubProp::Status => Value::Status(v.status.0),
@@ -653,9 +643,9 @@ impl<'ir> Driven<'ir> {
 
     fn sub_index(&self, sub: &str) -> Result<usize, rcs_runtime::driver::DriveError> {
         let c = self.interp.controller();
-        c.subordinates
-            .iter()
-            .position(|s| self.ir.controller(*s).name == sub)
+        self.ir
+            .controller_by_name(sub)
+            .and_then(|id| c.subordinate_index(id))
             .ok_or_else(|| rcs_runtime::driver::unknown(&c.name, "subordinate", sub))
     }
 
@@ -760,7 +750,7 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
                 .sent
                 .into_iter()
                 .map(|s| rcs_runtime::driver::Sent {
-                    sub: c.subordinates.iter().position(|x| *x == s.sub).unwrap_or(0) as u16,
+                    sub: c.subordinate_index(s.sub).unwrap_or(0) as u16,
                     verb: s.command.0 as u16,
                     args: s.args,
                     serial: s.serial,

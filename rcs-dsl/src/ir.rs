@@ -537,6 +537,11 @@ impl Ir {
 }
 
 impl Controller {
+    /// The position of `sub` among this controller's subordinates.
+    pub fn subordinate_index(&self, sub: CtrlId) -> Option<usize> {
+        self.subordinates.iter().position(|s| *s == sub)
+    }
+
     /// The plan of a verb, by name.
     pub fn plan_of(&self, verb: &str) -> Option<&Plan> {
         let c = self.commands.iter().find(|c| c.name == verb)?;

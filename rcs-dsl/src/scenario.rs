@@ -232,10 +232,9 @@ impl Resolver<'_> {
 
     /// The index of subordinate `name` in this controller's `subordinates`.
     fn sub_index(&self, line: usize, name: &str) -> Result<usize, ScenarioError> {
-        self.c
-            .subordinates
-            .iter()
-            .position(|s| self.ir.controller(*s).name == name)
+        self.ir
+            .controller_by_name(name)
+            .and_then(|id| self.c.subordinate_index(id))
             .ok_or_else(|| {
                 err(
                     line,
@@ -650,14 +649,13 @@ fn drive(
         for (h, v) in &step.hooks {
             d.set_hook(&c.hooks[h.index()].name, v).map_err(fail)?;
         }
+        for (i, setting) in &step.subs {
+            subs[*i] = setting.clone();
+        }
         // `echo: current` is the serial last sent as of the start of the step.
         let mut echoes = Vec::with_capacity(subs.len());
         for (i, sub) in subs.iter().enumerate() {
             echoes.push(echo_of(sub.echo, d.last_sent(sub_name(i)).map_err(fail)?));
-        }
-        for (i, setting) in &step.subs {
-            subs[*i] = setting.clone();
-            echoes[*i] = echo_of(setting.echo, d.last_sent(sub_name(*i)).map_err(fail)?);
         }
         if k == 0 {
             continue; // `initial` sets the scene; it runs no cycle.

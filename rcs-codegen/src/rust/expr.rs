@@ -224,12 +224,7 @@ impl Gen<'_> {
             }
             ExprKind::Call(h, args) => self.call(*h, args),
             ExprKind::Sub(c, prop) => {
-                let i = self
-                    .ctrl
-                    .subordinates
-                    .iter()
-                    .position(|s| s == c)
-                    .expect("a subordinate");
+                let i = self.ctrl.subordinate_index(*c).expect("a subordinate");
                 let id = &self.cn().subs[i];
                 Code::atom(match prop {
                     // `subs`: the cycle's local copy (see the controller's `cycle`).
@@ -459,12 +454,7 @@ impl Gen<'_> {
             Job::Send {
                 sub, command, args, ..
             } => {
-                let i = self
-                    .ctrl
-                    .subordinates
-                    .iter()
-                    .position(|s| s == sub)
-                    .expect("a subordinate");
+                let i = self.ctrl.subordinate_index(*sub).expect("a subordinate");
                 let field = prefixed("sub", &self.cn().subs[i]);
                 let target = &self.names.ctrls[sub.index()];
                 let module = &target.module;

@@ -12,7 +12,7 @@
 //! two and needs no network.
 
 use rcs_dsl::ir::Ir;
-use std::io::{BufReader, Write};
+use std::io::BufReader;
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
 
@@ -173,8 +173,6 @@ pub fn build(irs: &[&Ir], target_dir: &Path, status: &dyn Fn(&str)) -> Result<Dr
     let (Some(stdin), Some(stdout)) = (child.stdin.take(), child.stdout.take()) else {
         return Err("the scenario driver has no pipes".to_string());
     };
-    let mut stdin = stdin;
-    stdin.flush().map_err(|e| e.to_string())?;
     Ok(Driver {
         child,
         pipes: Some((BufReader::new(stdout), stdin)),
@@ -193,14 +191,7 @@ mod tests {
 
     #[test]
     fn the_crate_names_every_set_and_is_marked_generated() {
-        let set = rcs_dsl::PlanSet::from_texts(
-            "a",
-            [("a.rcs", "controller A {\n    command GO\n    plan GO {\n        *0 when new_command -> Done\n    }\n}\n")],
-            None,
-        );
-        let ir = rcs_dsl::check(&set, &rcs_dsl::Options::default())
-            .ir
-            .unwrap();
+        let ir = crate::tests::one_controller();
         let files = crate_files(&[&ir, &ir]);
         let paths: Vec<&str> = files.iter().map(|f| f.path.as_str()).collect();
         assert_eq!(

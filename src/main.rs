@@ -339,19 +339,10 @@ fn test(args: TestArgs) -> ExitCode {
         Ok(p) => p,
         Err(reason) => return fail(reason),
     };
-    let options = args.common.options();
-    let mut counts = Counts::default();
-    let mut irs = Vec::with_capacity(sets.len());
-    for set in &sets {
-        let checked = rcs_dsl::check(set, &options);
-        print_diagnostics(set, &checked, &args.common, false, &mut counts);
-        irs.push(checked.ir);
-    }
-    print_summary(&args.common, &counts);
-    let irs: Vec<_> = irs.into_iter().flatten().collect();
-    if counts.errors > 0 || irs.len() != sets.len() {
-        return ExitCode::from(1);
-    }
+    let irs = match check_sets(&sets, &args.common, false, None) {
+        Ok(irs) => irs,
+        Err(code) => return code,
+    };
 
     let mut driver = None;
     if args.backend == test_cmd::Backend::Compiled {
@@ -495,18 +486,44 @@ fn check(args: CheckArgs) -> ExitCode {
         Ok(sets) => sets,
         Err(e) => return fail(e),
     };
-    let options = args.common.options();
+    match check_sets(&sets, &args.common, false, None) {
+        Ok(_) => ExitCode::SUCCESS,
+        Err(code) => code,
+    }
+}
+
+/// Check every plan set, printing diagnostics (JSON to stdout unless
+/// `stdout_busy`) and the summary line; with `status`, a `Checking` line
+/// per set. `Err` is exit status 1 when any set has an error.
+fn check_sets(
+    sets: &[rcs_dsl::PlanSet],
+    common: &Common,
+    stdout_busy: bool,
+    status: Option<&Status>,
+) -> Result<Vec<rcs_dsl::ir::Ir>, ExitCode> {
+    let options = common.options();
     let mut counts = Counts::default();
-    for set in &sets {
+    let mut irs = Vec::with_capacity(sets.len());
+    for set in sets {
+        if let Some(status) = status {
+            status.line(
+                "Checking",
+                format!(
+                    "{} ({})",
+                    set_name(set),
+                    plural(set.rcs_files.len(), "file")
+                ),
+            );
+        }
         let checked = rcs_dsl::check(set, &options);
-        print_diagnostics(set, &checked, &args.common, false, &mut counts);
+        print_diagnostics(set, &checked, common, stdout_busy, &mut counts);
+        irs.extend(checked.ir);
     }
-    print_summary(&args.common, &counts);
-    if counts.errors > 0 {
-        ExitCode::from(1)
-    } else {
-        ExitCode::SUCCESS
+    print_summary(common, &counts);
+    if counts.errors > 0 || irs.len() != sets.len() {
+        return Err(ExitCode::from(1));
     }
+    Ok(irs)
 }
 
 /// cargo-style progress lines on stderr: a right-aligned verb (bold green
@@ -553,29 +570,11 @@ fn build(args: BuildArgs) -> ExitCode {
         Ok(sets) => sets,
         Err(e) => return fail(e),
     };
-    let options = args.common.options();
-
     // Check everything before writing anything.
-    let mut counts = Counts::default();
-    let mut irs = Vec::with_capacity(sets.len());
-    for set in &sets {
-        status.line(
-            "Checking",
-            format!(
-                "{} ({})",
-                set_name(set),
-                plural(set.rcs_files.len(), "file")
-            ),
-        );
-        let checked = rcs_dsl::check(set, &options);
-        print_diagnostics(set, &checked, &args.common, false, &mut counts);
-        irs.push(checked.ir);
-    }
-    print_summary(&args.common, &counts);
-    let irs: Vec<_> = irs.into_iter().flatten().collect();
-    if counts.errors > 0 || irs.len() != sets.len() {
-        return ExitCode::from(1);
-    }
+    let irs = match check_sets(&sets, &args.common, false, Some(&status)) {
+        Ok(irs) => irs,
+        Err(code) => return code,
+    };
 
     let files = match output_files(&irs) {
         Ok(files) => files,
@@ -634,21 +633,8 @@ fn checked_irs(
     common: &Common,
 ) -> Result<Vec<(rcs_dsl::PlanSet, rcs_dsl::ir::Ir)>, ExitCode> {
     let sets = rcs_dsl::load_paths(&default_paths(paths)).map_err(fail)?;
-    let options = common.options();
-    let mut counts = Counts::default();
-    let mut out = Vec::with_capacity(sets.len());
-    for set in sets {
-        let checked = rcs_dsl::check(&set, &options);
-        print_diagnostics(&set, &checked, common, true, &mut counts);
-        if let Some(ir) = checked.ir {
-            out.push((set, ir));
-        }
-    }
-    print_summary(common, &counts);
-    if counts.errors > 0 {
-        return Err(ExitCode::from(1));
-    }
-    Ok(out)
+    let irs = check_sets(&sets, common, true, None)?;
+    Ok(sets.into_iter().zip(irs).collect())
 }
 
 /// Write a command's product to `out` (a file) or to stdout.
@@ -809,16 +795,21 @@ mod tests {
         assert_eq!(plural(3, "file"), "3 files");
     }
 
-    #[test]
-    fn several_sets_with_one_name_are_refused() {
+    /// The IR of a one-controller, one-plan set named `a`.
+    pub(crate) fn one_controller() -> rcs_dsl::ir::Ir {
         let set = rcs_dsl::PlanSet::from_texts(
             "a",
             [("a.rcs", "controller A {\n    command GO\n    plan GO {\n        *0 when new_command -> Done\n    }\n}\n")],
             None,
         );
-        let ir = rcs_dsl::check(&set, &rcs_dsl::Options::default())
+        rcs_dsl::check(&set, &rcs_dsl::Options::default())
             .ir
-            .unwrap();
+            .unwrap()
+    }
+
+    #[test]
+    fn several_sets_with_one_name_are_refused() {
+        let ir = one_controller();
         let one = output_files(std::slice::from_ref(&ir)).unwrap();
         assert!(one.iter().any(|f| f.path == "graphs/hierarchy.dot"));
         assert!(output_files(&[ir.clone(), ir]).is_err());

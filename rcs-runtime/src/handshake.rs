@@ -16,6 +16,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::gm::{GlobalMemory, Reader, Stamped, Writer};
+use crate::seqlock::Staged;
 use crate::SetupError;
 
 /// A command verb of one controller, by its position in the declaration.
@@ -182,11 +183,17 @@ impl SubordinateView {
 /// A supervisor's bookkeeping for one subordinate: the serial it last sent,
 /// the last status generation it saw and the resulting view. Works on plain
 /// values, so it serves generated code and interpreters alike.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 pub struct SubordinateLink {
     last_sent: u32,
     seen_generation: u64,
     view: SubordinateView,
+}
+
+impl Default for SubordinateLink {
+    fn default() -> Self {
+        Self::new()
+    }
 }
 
 impl SubordinateLink {
@@ -232,13 +239,19 @@ impl SubordinateLink {
             // A status for an older command never counts for the newer one.
             (Status::EXECUTING, ErrorCode::NONE)
         };
-        self.view = SubordinateView {
+        // Field by field: a whole-struct store is built on the stack with
+        // narrow stores and copied with wide loads, which stall the CPU
+        // (see `seqlock`'s module docs).
+        self.view.status = status;
+        self.view.error = error;
+        self.view.stale_cycles = stale;
+        self.view.raw = raw;
+        SubordinateView {
             status,
             error,
             stale_cycles: stale,
             raw,
-        };
-        self.view
+        }
     }
 
     /// The view computed by the last [`observe`](Self::observe).
@@ -280,7 +293,9 @@ pub struct Subordinate<C: Command> {
     link: SubordinateLink,
     status: Reader<StatusBuffer>,
     command: Writer<CommandBuffer<C>>,
-    out: CommandBuffer<C>,
+    /// The command of the last `send`, kept as words so that `flush`
+    /// reads it back without a store-forwarding stall.
+    out: Staged<CommandBuffer<C>>,
     dirty: bool,
 }
 
@@ -293,7 +308,7 @@ impl<C: Command> Subordinate<C> {
             link: SubordinateLink::new(),
             status: gm.status_reader(ctrl)?,
             command: gm.command_writer::<C>(ctrl)?,
-            out: CommandBuffer::default(),
+            out: Staged::new(CommandBuffer::default()),
             dirty: false,
         })
     }
@@ -316,7 +331,7 @@ impl<C: Command> Subordinate<C> {
     #[inline]
     pub fn send(&mut self, command: C) -> u32 {
         let serial = self.link.next_command();
-        self.out = CommandBuffer { serial, command };
+        self.out.set(CommandBuffer { serial, command });
         self.dirty = true;
         serial
     }
@@ -326,7 +341,7 @@ impl<C: Command> Subordinate<C> {
     #[inline]
     pub fn flush(&mut self, cycle: u64) -> bool {
         if self.dirty {
-            self.command.write(self.out, cycle);
+            self.command.write(self.out.get(), cycle);
             self.dirty = false;
             true
         } else {
@@ -336,7 +351,7 @@ impl<C: Command> Subordinate<C> {
 
     /// The command most recently sent (serial 0: none).
     pub fn last_command(&self) -> CommandBuffer<C> {
-        self.out
+        self.out.get()
     }
 
     /// The underlying link.

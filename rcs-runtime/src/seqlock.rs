@@ -42,16 +42,105 @@
 //!   (RFC 3301, `AtomicPerByte`) once the language has one.
 //! * `T: Copy` means no destructors and no ownership are duplicated by the
 //!   byte copies.
+//!
+//! # Why the copies go word by word
+//!
+//! The value is kept padded to whole 8-byte words ([`Words`]) and both sides
+//! copy it as the same sequence of 8-byte volatile accesses. A reader that
+//! runs right after a write on the same core (a supervisor reading what its
+//! subordinate wrote a few nanoseconds earlier, or any single-threaded test
+//! loop) then loads exactly the words the writer stored, which the CPU
+//! forwards from its store buffer. A plain volatile copy of `T` lets the
+//! compiler choose different access widths on the two sides (a 1-byte store
+//! of an enum field, an 8-byte load spanning it): such a load cannot be
+//! forwarded and stalls for ≈ 15 cycles, and whether it happens depended on
+//! how the caller's code was inlined (measured in `BENCHMARKS.md`, the
+//! servo-loop section).
 
 use std::cell::UnsafeCell;
-use std::mem::MaybeUninit;
+use std::fmt;
+use std::mem::{ManuallyDrop, MaybeUninit};
 use std::ptr;
 use std::sync::atomic::{fence, AtomicU64, Ordering};
 
 /// A cell with one writer and any number of concurrent readers.
 pub(crate) struct SeqLock<T> {
     seq: AtomicU64,
-    data: UnsafeCell<T>,
+    data: UnsafeCell<Words<T>>,
+}
+
+/// `T` padded to whole 8-byte words and aligned to at least 8, so that it
+/// can be copied as `[MaybeUninit<u64>; words::<T>()]` (a union's size is a
+/// multiple of its alignment).
+#[repr(C, align(8))]
+#[derive(Clone, Copy)]
+union Words<T> {
+    value: ManuallyDrop<T>,
+}
+
+/// The number of 8-byte words in `Words<T>`.
+const fn words<T>() -> usize {
+    std::mem::size_of::<Words<T>>() / 8
+}
+
+/// A `T` that is stored as whole 8-byte words, for a value written in one
+/// step of a cycle and read back in a later one (a subordinate's pending
+/// command, written at `send` and copied to Global Memory at `flush`). Read
+/// back soon after a plain store of a struct, loads the compiler widened
+/// over several narrow field stores stall the CPU (see the module docs);
+/// loads from a value stored as words are always forwarded.
+pub(crate) struct Staged<T> {
+    words: Words<T>,
+}
+
+impl<T: Copy> Staged<T> {
+    /// A slot holding `value`.
+    pub(crate) const fn new(value: T) -> Self {
+        Self {
+            words: Words {
+                value: ManuallyDrop::new(value),
+            },
+        }
+    }
+
+    /// Replace the value, storing it word by word.
+    #[inline]
+    pub(crate) fn set(&mut self, value: T) {
+        let src = Words {
+            value: ManuallyDrop::new(value),
+        };
+        let src = (&raw const src).cast::<MaybeUninit<u64>>();
+        let dst = (&raw mut self.words).cast::<MaybeUninit<u64>>();
+        for i in 0..words::<T>() {
+            // Volatile, or the compiler turns the word copy back into
+            // narrow field stores. SAFETY: both point to a `Words<T>`,
+            // 8-aligned and `words::<T>()` whole words long;
+            // `MaybeUninit<u64>` may hold padding bytes. The words written
+            // are those of a valid `T`.
+            unsafe { ptr::write_volatile(dst.add(i), src.add(i).read()) };
+        }
+    }
+
+    /// The value.
+    #[inline]
+    pub(crate) fn get(&self) -> T {
+        // SAFETY: `new` and `set` only ever store a whole valid `T`.
+        unsafe { *self.words.value }
+    }
+}
+
+impl<T: Copy> Clone for Staged<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T: Copy> Copy for Staged<T> {}
+
+impl<T: Copy + fmt::Debug> fmt::Debug for Staged<T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.get().fmt(f)
+    }
 }
 
 // SAFETY: readers only obtain copies of `T` (which is `Copy`, so copying is
@@ -65,7 +154,9 @@ impl<T: Copy> SeqLock<T> {
     pub(crate) const fn new(value: T) -> Self {
         Self {
             seq: AtomicU64::new(0),
-            data: UnsafeCell::new(value),
+            data: UnsafeCell::new(Words {
+                value: ManuallyDrop::new(value),
+            }),
         }
     }
 
@@ -81,9 +172,19 @@ impl<T: Copy> SeqLock<T> {
         let s = self.seq.load(Ordering::Relaxed);
         self.seq.store(s.wrapping_add(1), Ordering::Relaxed);
         fence(Ordering::Release);
-        // SAFETY: `data` is valid for writes; the caller excludes other
-        // writers; readers that overlap this store discard what they copied.
-        unsafe { ptr::write_volatile(self.data.get(), value) };
+        let src = Words {
+            value: ManuallyDrop::new(value),
+        };
+        let src = (&raw const src).cast::<MaybeUninit<u64>>();
+        let dst = self.data.get().cast::<MaybeUninit<u64>>();
+        for i in 0..words::<T>() {
+            // SAFETY: `src` and `dst` point to a `Words<T>`: 8-aligned and
+            // `words::<T>()` whole words long, so every word is in bounds and
+            // aligned. `MaybeUninit<u64>` may hold padding bytes. The caller
+            // excludes other writers; readers that overlap these stores
+            // discard what they copied.
+            unsafe { ptr::write_volatile(dst.add(i), src.add(i).read()) };
+        }
         let next = s.wrapping_add(2);
         self.seq.store(next, Ordering::Release);
         next / 2
@@ -96,17 +197,26 @@ impl<T: Copy> SeqLock<T> {
         if s1 & 1 != 0 {
             return None;
         }
-        // SAFETY: `data` is valid for reads of `size_of::<T>()` bytes. The
-        // copy lands in a `MaybeUninit`, which accepts any bytes, and is only
-        // assumed initialised below after the sequence check.
-        let copy = unsafe { ptr::read_volatile(self.data.get() as *const MaybeUninit<T>) };
+        let mut copy = MaybeUninit::<Words<T>>::uninit();
+        let src = self.data.get().cast_const().cast::<MaybeUninit<u64>>();
+        let dst = copy.as_mut_ptr().cast::<MaybeUninit<u64>>();
+        for i in 0..words::<T>() {
+            // SAFETY: both point to a `Words<T>`, 8-aligned and
+            // `words::<T>()` whole words long. The copy lands in a
+            // `MaybeUninit`, which accepts any bytes, and is only assumed
+            // initialised below after the sequence check.
+            unsafe { dst.add(i).write(ptr::read_volatile(src.add(i))) };
+        }
         fence(Ordering::Acquire);
         let s2 = self.seq.load(Ordering::Relaxed);
         if s1 == s2 {
             // SAFETY: no write started or finished while we copied (the
             // counter was even and unchanged), so the bytes are exactly those
             // of one complete `write` (or of `new`): a valid `T`.
-            Some((unsafe { copy.assume_init() }, s1 / 2))
+            Some((
+                unsafe { ManuallyDrop::into_inner(copy.assume_init().value) },
+                s1 / 2,
+            ))
         } else {
             None
         }
@@ -141,9 +251,90 @@ impl<T: Copy> SeqLock<T> {
 
 #[cfg(test)]
 mod tests {
-    use super::SeqLock;
+    use super::{words, SeqLock, Staged};
     use std::sync::atomic::{AtomicBool, Ordering};
     use std::sync::Arc;
+
+    /// Write then read `values` through a cell and a staged slot; every
+    /// value must come back exactly, whatever its size and alignment.
+    fn round_trip<T: Copy + PartialEq + std::fmt::Debug + Default>(values: &[T]) {
+        let cell = SeqLock::new(T::default());
+        let mut staged = Staged::new(T::default());
+        assert_eq!(cell.read().0, T::default());
+        assert_eq!(staged.get(), T::default());
+        for (i, &v) in values.iter().enumerate() {
+            assert_eq!(unsafe { cell.write(v) }, i as u64 + 1);
+            assert_eq!(cell.read(), (v, i as u64 + 1));
+            staged.set(v);
+            assert_eq!(staged.get(), v);
+            let copy = staged;
+            assert_eq!(copy.get(), v);
+        }
+    }
+
+    #[derive(Clone, Copy, Debug, Default, PartialEq)]
+    struct Odd {
+        a: u8,
+        b: u16,
+        c: bool,
+    }
+
+    #[derive(Clone, Copy, Debug, Default, PartialEq)]
+    struct Mixed {
+        flag: bool,
+        x: f64,
+        n: u32,
+        tag: Option<u16>,
+    }
+
+    #[test]
+    fn words_cover_the_value_padded_to_eight_bytes() {
+        assert_eq!(words::<()>(), 0);
+        assert_eq!(words::<u8>(), 1);
+        assert_eq!(words::<[u8; 8]>(), 1);
+        assert_eq!(words::<[u8; 9]>(), 2);
+        assert_eq!(words::<Odd>(), 1);
+        assert_eq!(words::<Mixed>(), 3);
+        assert_eq!(words::<u128>(), 2);
+        assert!(std::mem::align_of::<super::Words<u8>>() >= 8);
+        assert!(std::mem::align_of::<super::Words<u128>>() >= 16);
+    }
+
+    #[test]
+    fn values_of_every_size_and_alignment_come_back_whole() {
+        round_trip(&[(), ()]);
+        round_trip(&[1u8, 255, 0]);
+        round_trip(&[[1u8, 2, 3], [255, 0, 7]]);
+        round_trip(&[[9u8; 9], [1u8; 9]]);
+        round_trip(&[
+            Odd {
+                a: 1,
+                b: 0xBEEF,
+                c: true,
+            },
+            Odd {
+                a: 255,
+                b: 1,
+                c: false,
+            },
+        ]);
+        round_trip(&[
+            Mixed {
+                flag: true,
+                x: -0.5,
+                n: u32::MAX,
+                tag: Some(7),
+            },
+            Mixed {
+                flag: false,
+                x: f64::MAX,
+                n: 1,
+                tag: None,
+            },
+        ]);
+        round_trip(&[u128::MAX, 1u128 << 100, 0]);
+        round_trip(&[(3.5f64, 17u64), (f64::MIN_POSITIVE, u64::MAX)]);
+    }
 
     #[test]
     fn single_thread_write_read() {

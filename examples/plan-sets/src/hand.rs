@@ -181,6 +181,9 @@ impl Controller for Propulsion {
         "PR"
     }
 
+    // `#[inline]` so that a caller in another crate may inline it, as it may
+    // the generated `cycle` (generic, so compiled in the caller's crate).
+    #[inline]
     fn cycle(&mut self, ctx: &CycleContext) {
         let cmd = self.cmd_in.read().value;
         self.ship = self.ship_in.read().value;

@@ -79,9 +79,32 @@ impl<
         S: Copy + Default + Send + 'static,
     > RustLoop<C, P, T, S>
 {
-    /// One cycle: the world answers, then PR runs.
+    /// One cycle: the world answers, then PR runs, called the way the
+    /// runtime's `Executive` calls every controller: through
+    /// `&mut dyn Controller`, so the cycle is never inlined into the caller.
     #[inline]
     pub fn step(&mut self) {
+        self.world();
+        let ctrl: &mut dyn Controller = &mut self.ctrl;
+        std::hint::black_box(ctrl).cycle(&self.ctx);
+        self.ctx.cycle += 1;
+    }
+
+    /// One cycle with PR's `cycle` called directly, so the compiler may
+    /// inline it into the caller (the generated controller is generic over
+    /// its hooks, so it is compiled in the caller's crate; the hand-written
+    /// one is marked `#[inline]` for the same effect). How fast this runs depends on the caller's loop as much
+    /// as on the controller; the benchmark reports it beside [`step`](Self::step).
+    #[inline]
+    pub fn step_inlined(&mut self) {
+        self.world();
+        self.ctrl.cycle(&self.ctx);
+        self.ctx.cycle += 1;
+    }
+
+    /// The turbine answers DONE to the last command; the ship moves on.
+    #[inline]
+    fn world(&mut self) {
         let sent = self.tb_command.read().value.serial;
         let done = StatusBuffer {
             echo_serial: sent,
@@ -92,8 +115,6 @@ impl<
         self.ship
             .write((self.make_ship)(SHIP_SPEEDS[self.turn % 3]), self.ctx.cycle);
         self.turn += 1;
-        self.ctrl.cycle(&self.ctx);
-        self.ctx.cycle += 1;
     }
 
     pub fn observe(&self) -> Observation {

@@ -125,7 +125,7 @@ fn scenario_mistakes_are_refused_with_their_line() {
     for (file, line, message) in [
         ("bad_controller", 1, "unknown controller `B`"),
         ("bad_field", 4, "has no field `depth`"),
-        ("bad_row", 3, "no row of `A` is called `E7`"),
+        ("bad_row", 4, "no row of `A` is called `E7`"),
     ] {
         let at = format!("scenarios/{file}.scenario.yaml:{line}: error: ");
         let hit = stdout.lines().find(|l| l.contains(&at));

@@ -27,18 +27,18 @@ struct RawScenario {
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct RawSettings {
-    reads: Option<Json>,
-    hooks: Option<Json>,
-    subordinates: Option<Json>,
+    reads: Option<Entries>,
+    hooks: Option<Entries>,
+    subordinates: Option<Entries>,
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawStep {
-    command: Option<Json>,
-    reads: Option<Json>,
-    hooks: Option<Json>,
-    subordinates: Option<Json>,
+    command: Option<Spanned<Json>>,
+    reads: Option<Entries>,
+    hooks: Option<Entries>,
+    subordinates: Option<Entries>,
     cycles: Option<u32>,
     expect: Option<RawExpect>,
 }
@@ -46,13 +46,73 @@ struct RawStep {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawExpect {
-    fired: Option<Json>,
-    state: Option<String>,
-    status: Option<String>,
-    error: Option<String>,
-    sent: Option<Json>,
-    vars: Option<Json>,
-    writes: Option<Json>,
+    fired: Option<Spanned<Json>>,
+    state: Option<Spanned<String>>,
+    status: Option<Spanned<String>>,
+    error: Option<Spanned<String>>,
+    sent: Option<Entries>,
+    vars: Option<Entries>,
+    writes: Option<Entries>,
+}
+
+/// A YAML mapping of names to values (`reads:`, `hooks:`, `sent:` …), in
+/// file order, each entry with the line of its key, so that a name the
+/// plans lack is reported on its own line.
+#[derive(Default)]
+struct Entries(Vec<Entry>);
+
+struct Entry {
+    line: usize,
+    name: String,
+    value: Json,
+}
+
+impl<'de> Deserialize<'de> for Entries {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = Entries;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a mapping of names to values")
+            }
+            fn visit_unit<E>(self) -> Result<Entries, E> {
+                Ok(Entries::default())
+            }
+            fn visit_none<E>(self) -> Result<Entries, E> {
+                Ok(Entries::default())
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                mut m: A,
+            ) -> Result<Entries, A::Error> {
+                let mut out = Vec::new();
+                while let Some(key) = m.next_key::<Spanned<String>>()? {
+                    let line = key.referenced.line() as usize;
+                    if out.iter().any(|e: &Entry| e.name == key.value) {
+                        return Err(serde::de::Error::custom(format_args!(
+                            "`{}` is named twice",
+                            key.value
+                        )));
+                    }
+                    out.push(Entry {
+                        line,
+                        name: key.value,
+                        value: m.next_value()?,
+                    });
+                }
+                Ok(Entries(out))
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
+}
+
+/// The entries of an optional mapping: (line of the key, name, value).
+fn entries(e: &Option<Entries>) -> impl Iterator<Item = (usize, &str, &Json)> {
+    e.as_ref()
+        .map_or(&[][..], |e| &e.0)
+        .iter()
+        .map(|e| (e.line, e.name.as_str(), &e.value))
 }
 
 /// A problem with a scenario file (not a failed expectation): where and what.
@@ -170,16 +230,18 @@ impl Resolver<'_> {
     fn step(
         &self,
         line: usize,
-        command: Option<Json>,
-        reads: Option<Json>,
-        hooks: Option<Json>,
-        subs: Option<Json>,
+        command: Option<Spanned<Json>>,
+        reads: Option<Entries>,
+        hooks: Option<Entries>,
+        subs: Option<Entries>,
         cycles: Option<u32>,
         expect: Option<RawExpect>,
     ) -> Result<Step, ScenarioError> {
-        let command = command.map(|c| self.command(line, &c)).transpose()?;
+        let command = command
+            .map(|c| self.command(c.referenced.line() as usize, &c.value))
+            .transpose()?;
         let mut read_list = Vec::new();
-        for (name, v) in object(line, reads.as_ref(), "reads")? {
+        for (line, name, v) in entries(&reads) {
             let i = self
                 .c
                 .reads
@@ -192,7 +254,7 @@ impl Resolver<'_> {
             read_list.push((i, v.clone()));
         }
         let mut hook_list = Vec::new();
-        for (name, v) in object(line, hooks.as_ref(), "hooks")? {
+        for (line, name, v) in entries(&hooks) {
             let h = self
                 .c
                 .hooks
@@ -203,13 +265,13 @@ impl Resolver<'_> {
             hook_list.push((HookId(h as u32), value));
         }
         let mut sub_list = Vec::new();
-        for (name, v) in object(line, subs.as_ref(), "subordinates")? {
+        for (line, name, v) in entries(&subs) {
             let i = self.sub_index(line, name)?;
             let sub = self.ir.controller(self.c.subordinates[i]);
             sub_list.push((i, self.sub_setting(line, sub, v)?));
         }
         let expect = match expect {
-            Some(e) => self.expect(line, e)?,
+            Some(e) => self.expect(e)?,
             None => Expect::default(),
         };
         Ok(Step {
@@ -292,10 +354,11 @@ impl Resolver<'_> {
         }
     }
 
-    fn expect(&self, line: usize, e: RawExpect) -> Result<Expect, ScenarioError> {
+    fn expect(&self, e: RawExpect) -> Result<Expect, ScenarioError> {
         let mut out = Expect::default();
         if let Some(f) = e.fired {
-            let name = match &f {
+            let line = f.referenced.line() as usize;
+            let name = match &f.value {
                 Json::String(s) => s.clone(),
                 Json::Number(n) => n.to_string(),
                 _ => {
@@ -323,7 +386,13 @@ impl Resolver<'_> {
                 out.fired = Some(Some(name));
             }
         }
-        if let Some(s) = e.state {
+        if let Some(Spanned {
+            value: s,
+            referenced,
+            ..
+        }) = e.state
+        {
+            let line = referenced.line() as usize;
             let known = s == "S0"
                 || self
                     .c
@@ -339,7 +408,13 @@ impl Resolver<'_> {
             }
             out.state = Some(s);
         }
-        if let Some(s) = e.status {
+        if let Some(Spanned {
+            value: s,
+            referenced,
+            ..
+        }) = e.status
+        {
+            let line = referenced.line() as usize;
             let i = self
                 .c
                 .statuses
@@ -348,7 +423,13 @@ impl Resolver<'_> {
                 .ok_or_else(|| err(line, format!("`{}` has no status `{s}`", self.c.name)))?;
             out.status = Some(i as u16);
         }
-        if let Some(x) = e.error {
+        if let Some(Spanned {
+            value: x,
+            referenced,
+            ..
+        }) = e.error
+        {
+            let line = referenced.line() as usize;
             out.error = Some(match x.as_str() {
                 "none" => None,
                 "UNKNOWN_COMMAND" => Some(rcs_runtime::ErrorCode::UNKNOWN_COMMAND.0),
@@ -368,9 +449,9 @@ impl Resolver<'_> {
                 }
             });
         }
-        if let Some(sent) = e.sent {
+        if e.sent.is_some() {
             let mut list = Vec::new();
-            for (name, v) in object(line, Some(&sent), "sent")? {
+            for (line, name, v) in entries(&e.sent) {
                 let si = self.sub_index(line, name)?;
                 let sub = self.ir.controller(self.c.subordinates[si]);
                 let (cmd, vals) = verb_call(self.ir, sub, line, v, || {
@@ -380,7 +461,7 @@ impl Resolver<'_> {
             }
             out.sent = Some(list);
         }
-        for (name, v) in object(line, e.vars.as_ref(), "vars")? {
+        for (line, name, v) in entries(&e.vars) {
             let i = self
                 .c
                 .vars
@@ -390,7 +471,7 @@ impl Resolver<'_> {
             out.vars
                 .push((i, value(self.ir, line, &self.c.vars[i].ty, v, name)?));
         }
-        for (name, v) in object(line, e.writes.as_ref(), "writes")? {
+        for (line, name, v) in entries(&e.writes) {
             let i = self
                 .c
                 .writes

@@ -19,15 +19,27 @@ pub struct YamlError {
 pub fn from_str<T: DeserializeOwned>(text: &str) -> Result<T, YamlError> {
     let options = serde_saphyr::options! { with_snippet: false };
     serde_saphyr::from_str_with_options(text, options).map_err(|e| YamlError {
-        message: e
-            .to_string()
-            .lines()
-            .next()
-            .unwrap_or("")
-            .trim()
-            .to_string(),
+        message: message(e.to_string().lines().next().unwrap_or("")),
         location: e.location(),
     })
+}
+
+/// The library's message without what callers say themselves (the place,
+/// which they print as `file:line:`) or what only a programmer can act on
+/// (the library option that would let duplicate keys through).
+fn message(first_line: &str) -> String {
+    let mut m = first_line.trim();
+    if let Some(at) = m.rfind(" at line ") {
+        let tail = &m[at + " at line ".len()..];
+        let is_place = tail
+            .split_once(", column ")
+            .is_some_and(|(l, c)| l.parse::<u64>().is_ok() && c.parse::<u64>().is_ok());
+        if is_place {
+            m = &m[..at];
+        }
+    }
+    let m = m.replace(", set DuplicateKeyPolicy in Options if acceptable", "");
+    m.replace("duplicate mapping key: ", "a key is given twice: ")
 }
 
 /// Any serialisable value as YAML.
@@ -70,4 +82,38 @@ fn offset_of(file: &SourceFile, line: u64, column: u64) -> usize {
             .nth((column as usize).saturating_sub(1))
             .map(|(i, _)| i)
             .unwrap_or(rest.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::BTreeMap;
+
+    fn error_of<T: DeserializeOwned + std::fmt::Debug>(text: &str) -> YamlError {
+        from_str::<T>(text).expect_err(text)
+    }
+
+    #[test]
+    fn a_duplicate_key_is_named_with_its_line_and_no_library_advice() {
+        let e = error_of::<BTreeMap<String, u32>>("a: 1\nb: 2\na: 3\n");
+        assert_eq!(e.message, "a key is given twice: a");
+        assert_eq!(e.location.map(|l| l.line()), Some(3));
+    }
+
+    #[test]
+    fn messages_leave_the_place_to_the_caller() {
+        for text in ["a: 1\nb: [x]\n", "a: 1\nb: nine\n"] {
+            let e = error_of::<BTreeMap<String, u32>>(text);
+            assert!(!e.message.is_empty(), "{text}");
+            assert!(!e.message.contains("at line"), "{text}: {}", e.message);
+            assert_eq!(e.location.map(|l| l.line()), Some(2), "{text}");
+        }
+    }
+
+    #[test]
+    fn only_a_trailing_place_is_cut() {
+        assert_eq!(message("bad at line 3, column 4"), "bad");
+        assert_eq!(message("found at line end"), "found at line end");
+        assert_eq!(message("  plain  "), "plain");
+    }
 }

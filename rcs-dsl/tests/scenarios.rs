@@ -106,7 +106,81 @@ fn names_the_plans_lack_are_refused_with_their_line() {
             "`PR` has no var `speed`",
         ),
     ];
-    for (text, line, message) in cases {
+    // Block layout: each mistake is reported on the line of its own key,
+    // not on the first line of its step.
+    let block = [
+        (
+            "controller: PR\nsteps:\n  - command: INIT\n    expect:\n      state: S1\n      fired: E9\n",
+            6,
+            "no row of `PR` is called `E9`",
+        ),
+        (
+            "controller: PR\nsteps:\n  - command: INIT\n    expect:\n      fired: E0\n      state: S7\n",
+            6,
+            "no plan of `PR` has a state `S7`",
+        ),
+        (
+            "controller: PR\nsteps:\n  - command: INIT\n    expect:\n      status: EXECUTING\n\n      error: MELTED\n",
+            7,
+            "`PR` has no error code `MELTED`",
+        ),
+        (
+            "controller: PR\nsteps:\n  - command: INIT\n    expect:\n      status: AT_REST\n",
+            5,
+            "`PR` has no status `AT_REST`",
+        ),
+        (
+            "controller: PR\nsteps:\n  - command: INIT\n    hooks:\n      required_rpm: 3.0\n      warp: 9\n",
+            6,
+            "`PR` has no hook `warp`",
+        ),
+        (
+            "controller: PR\nsteps:\n  - command: INIT\n  - subordinates:\n      TB: DONE\n      SM: DONE\n",
+            6,
+            "`SM` is not a subordinate of `PR`",
+        ),
+        (
+            "controller: PR\nsteps:\n  - command: INIT\n  - subordinates:\n      TB:\n        status: SPINNING\n",
+            5,
+            "`TB` has no status `SPINNING`",
+        ),
+        (
+            "controller: PR\nsteps:\n  - command: INIT\n    expect:\n      fired: E0\n      sent:\n        TB: FLY\n",
+            7,
+            "`TB` has no command `FLY`",
+        ),
+        (
+            "controller: PR\nsteps:\n  - command: INIT\n    expect:\n      vars:\n        rpm: 0.0\n        speed: 1.0\n",
+            7,
+            "`PR` has no var `speed`",
+        ),
+        (
+            "controller: TB\nsteps:\n  - command: INIT\n    expect:\n      writes:\n        drive: {}\n        brake: {}\n",
+            7,
+            "`TB` writes no buffer `brake`",
+        ),
+        (
+            "controller: PR\ninitial:\n  reads:\n    ship: {}\n    sea: {}\nsteps: []\n",
+            5,
+            "`PR` reads no buffer `sea`",
+        ),
+        (
+            "controller: PR\nsteps:\n  - command: INIT\n\n\n  - command:\n      AHEAD: { knots: 1.0 }\n",
+            7,
+            "command `AHEAD` of `PR` has no parameter `knots`",
+        ),
+        (
+            "controller: PR\nsteps:\n  - hooks:\n      required_rpm: 1.0\n      required_rpm: 2.0\n",
+            5,
+            "required_rpm",
+        ),
+        (
+            "controller: PR\nsteps:\n  - command: INIT\n    hooks: [required_rpm]\n",
+            4,
+            "mapping",
+        ),
+    ];
+    for (text, line, message) in cases.into_iter().chain(block) {
         let file = SourceFile::new("t.scenario.yaml", text);
         let e = scenario::parse(&ir, &file, "t")
             .err()

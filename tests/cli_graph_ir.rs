@@ -4,11 +4,8 @@
 use std::process::Command;
 
 mod common;
+mod graphviz;
 use common::{rcsc, scratch, text};
-
-fn has_dot() -> bool {
-    Command::new("dot").arg("-V").output().is_ok()
-}
 
 const BROKEN: &str = "controller A {\n    command GO\n    plan GO {\n        *0 when new_command && nope -> Done\n    }\n}\n";
 const UNUSED_VAR: &str = "controller A {\n    command GO\n    var spare: u8 = 0\n    plan GO {\n        *0 when new_command -> Done\n    }\n}\n";
@@ -76,8 +73,7 @@ fn graph_writes_to_a_file_with_out() {
 
 #[test]
 fn graph_renders_svg_through_graphviz() {
-    if !has_dot() {
-        eprintln!("note: Graphviz `dot` not found; SVG output not checked");
+    if !graphviz::dot_available("`rcsc graph --format svg`") {
         return;
     }
     let out = rcsc(&[

@@ -15,6 +15,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
+mod graphviz;
+
 /// One plan set to generate: where its snapshots go and its name there.
 struct Case {
     path: PathBuf,
@@ -99,27 +101,9 @@ fn generated_files_match_their_snapshots() {
     }
 }
 
-/// Whether Graphviz is here; without it, fail on CI and skip elsewhere.
-fn have_dot() -> bool {
-    let found = Command::new("dot")
-        .arg("-V")
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success());
-    if !found {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "Graphviz `dot` is not installed (CI is set, so this fails; install graphviz)"
-        );
-        eprintln!("note: Graphviz `dot` is not installed; skipping the DOT syntax test");
-    }
-    found
-}
-
 #[test]
 fn every_dot_file_renders_with_graphviz() {
-    if !have_dot() {
+    if !graphviz::dot_available("the generated DOT files") {
         return;
     }
     let (mut checked, mut failures) = (0, Vec::new());

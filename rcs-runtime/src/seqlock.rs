@@ -78,9 +78,41 @@ union Words<T> {
     value: ManuallyDrop<T>,
 }
 
+impl<T> Words<T> {
+    const fn new(value: T) -> Self {
+        Self {
+            value: ManuallyDrop::new(value),
+        }
+    }
+}
+
 /// The number of 8-byte words in `Words<T>`.
 const fn words<T>() -> usize {
     std::mem::size_of::<Words<T>>() / 8
+}
+
+/// Store `value` into `dst` as `words::<T>()` volatile 8-byte stores
+/// (volatile, or the compiler turns the word copy back into narrow field
+/// stores).
+///
+/// # Safety
+///
+/// `dst` is valid for writes of a `Words<T>`, and nothing else writes it
+/// meanwhile. Concurrent readers may see a mix of old and new words; they
+/// must not treat what they copied as a `T` unless they know no store
+/// overlapped their copy (the seqlock's counter check).
+#[inline]
+unsafe fn store_words<T>(dst: *mut Words<T>, value: T) {
+    let src = Words::new(value);
+    let src = (&raw const src).cast::<MaybeUninit<u64>>();
+    let dst = dst.cast::<MaybeUninit<u64>>();
+    for i in 0..words::<T>() {
+        // SAFETY: `src` and `dst` point to a `Words<T>`: 8-aligned and
+        // `words::<T>()` whole words long, so every word is in bounds and
+        // aligned; `MaybeUninit<u64>` may hold padding bytes. The caller
+        // vouches for `dst` being valid and written by nobody else.
+        unsafe { ptr::write_volatile(dst.add(i), src.add(i).read()) };
+    }
 }
 
 /// A `T` that is stored as whole 8-byte words, for a value written in one
@@ -97,28 +129,16 @@ impl<T: Copy> Staged<T> {
     /// A slot holding `value`.
     pub(crate) const fn new(value: T) -> Self {
         Self {
-            words: Words {
-                value: ManuallyDrop::new(value),
-            },
+            words: Words::new(value),
         }
     }
 
     /// Replace the value, storing it word by word.
     #[inline]
     pub(crate) fn set(&mut self, value: T) {
-        let src = Words {
-            value: ManuallyDrop::new(value),
-        };
-        let src = (&raw const src).cast::<MaybeUninit<u64>>();
-        let dst = (&raw mut self.words).cast::<MaybeUninit<u64>>();
-        for i in 0..words::<T>() {
-            // Volatile, or the compiler turns the word copy back into
-            // narrow field stores. SAFETY: both point to a `Words<T>`,
-            // 8-aligned and `words::<T>()` whole words long;
-            // `MaybeUninit<u64>` may hold padding bytes. The words written
-            // are those of a valid `T`.
-            unsafe { ptr::write_volatile(dst.add(i), src.add(i).read()) };
-        }
+        // SAFETY: `&mut self` makes the slot ours alone; the words written
+        // are those of a valid `T`.
+        unsafe { store_words(&raw mut self.words, value) };
     }
 
     /// The value.
@@ -154,9 +174,7 @@ impl<T: Copy> SeqLock<T> {
     pub(crate) const fn new(value: T) -> Self {
         Self {
             seq: AtomicU64::new(0),
-            data: UnsafeCell::new(Words {
-                value: ManuallyDrop::new(value),
-            }),
+            data: UnsafeCell::new(Words::new(value)),
         }
     }
 
@@ -172,19 +190,9 @@ impl<T: Copy> SeqLock<T> {
         let s = self.seq.load(Ordering::Relaxed);
         self.seq.store(s.wrapping_add(1), Ordering::Relaxed);
         fence(Ordering::Release);
-        let src = Words {
-            value: ManuallyDrop::new(value),
-        };
-        let src = (&raw const src).cast::<MaybeUninit<u64>>();
-        let dst = self.data.get().cast::<MaybeUninit<u64>>();
-        for i in 0..words::<T>() {
-            // SAFETY: `src` and `dst` point to a `Words<T>`: 8-aligned and
-            // `words::<T>()` whole words long, so every word is in bounds and
-            // aligned. `MaybeUninit<u64>` may hold padding bytes. The caller
-            // excludes other writers; readers that overlap these stores
-            // discard what they copied.
-            unsafe { ptr::write_volatile(dst.add(i), src.add(i).read()) };
-        }
+        // SAFETY: `data` is valid for writes; the caller excludes other
+        // writers; readers that overlap these stores discard what they copied.
+        unsafe { store_words(self.data.get(), value) };
         let next = s.wrapping_add(2);
         self.seq.store(next, Ordering::Release);
         next / 2

@@ -93,8 +93,9 @@ impl<
     /// One cycle with PR's `cycle` called directly, so the compiler may
     /// inline it into the caller (the generated controller is generic over
     /// its hooks, so it is compiled in the caller's crate; the hand-written
-    /// one is marked `#[inline]` for the same effect). How fast this runs depends on the caller's loop as much
-    /// as on the controller; the benchmark reports it beside [`step`](Self::step).
+    /// one is marked `#[inline]` for the same effect). How fast this runs
+    /// depends on the caller's loop as much as on the controller; the
+    /// benchmark reports it beside [`step`](Self::step).
     #[inline]
     pub fn step_inlined(&mut self) {
         self.world();
@@ -125,15 +126,7 @@ impl<
             (self.rpm_of)(&self.tb_command.read().value.command),
         )
     }
-}
 
-impl<
-        C: Controller,
-        P: rcs_runtime::Command,
-        T: rcs_runtime::Command,
-        S: Copy + Default + Send + 'static,
-    > RustLoop<C, P, T, S>
-{
     /// The harness around `ctrl` (already connected to `gm`): PR's
     /// supervisor, which sends `first` at once, the turbine and the ship.
     fn new(

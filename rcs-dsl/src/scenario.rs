@@ -86,16 +86,10 @@ impl<'de> Deserialize<'de> for Entries {
                 mut m: A,
             ) -> Result<Entries, A::Error> {
                 let mut out = Vec::new();
+                // Duplicate keys are refused by the YAML reader itself.
                 while let Some(key) = m.next_key::<Spanned<String>>()? {
-                    let line = key.referenced.line() as usize;
-                    if out.iter().any(|e: &Entry| e.name == key.value) {
-                        return Err(serde::de::Error::custom(format_args!(
-                            "`{}` is named twice",
-                            key.value
-                        )));
-                    }
                     out.push(Entry {
-                        line,
+                        line: line_of(&key),
                         name: key.value,
                         value: m.next_value()?,
                     });
@@ -105,6 +99,11 @@ impl<'de> Deserialize<'de> for Entries {
         }
         d.deserialize_any(Visitor)
     }
+}
+
+/// The line a scenario value was written on.
+fn line_of<T>(s: &Spanned<T>) -> usize {
+    s.referenced.line() as usize
 }
 
 /// The entries of an optional mapping: (line of the key, name, value).
@@ -181,7 +180,7 @@ fn err(line: usize, message: impl Into<String>) -> ScenarioError {
 pub fn parse(ir: &Ir, file: &SourceFile, stem: &str) -> Result<Scenario, ScenarioError> {
     let raw: RawScenario = yaml::from_str(&file.text)
         .map_err(|e| err(e.location.map_or(1, |l| l.line() as usize), e.message))?;
-    let cline = raw.controller.referenced.line() as usize;
+    let cline = line_of(&raw.controller);
     let ctrl = ir
         .controller_by_name(&raw.controller.value)
         .ok_or_else(|| {
@@ -200,7 +199,7 @@ pub fn parse(ir: &Ir, file: &SourceFile, stem: &str) -> Result<Scenario, Scenari
     };
     let mut steps = Vec::new();
     for s in raw.steps {
-        let line = s.referenced.line() as usize;
+        let line = line_of(&s);
         let v = s.value;
         steps.push(r.step(
             line,
@@ -238,7 +237,7 @@ impl Resolver<'_> {
         expect: Option<RawExpect>,
     ) -> Result<Step, ScenarioError> {
         let command = command
-            .map(|c| self.command(c.referenced.line() as usize, &c.value))
+            .map(|c| self.command(line_of(&c), &c.value))
             .transpose()?;
         let mut read_list = Vec::new();
         for (line, name, v) in entries(&reads) {
@@ -357,7 +356,7 @@ impl Resolver<'_> {
     fn expect(&self, e: RawExpect) -> Result<Expect, ScenarioError> {
         let mut out = Expect::default();
         if let Some(f) = e.fired {
-            let line = f.referenced.line() as usize;
+            let line = line_of(&f);
             let name = match &f.value {
                 Json::String(s) => s.clone(),
                 Json::Number(n) => n.to_string(),
@@ -386,13 +385,8 @@ impl Resolver<'_> {
                 out.fired = Some(Some(name));
             }
         }
-        if let Some(Spanned {
-            value: s,
-            referenced,
-            ..
-        }) = e.state
-        {
-            let line = referenced.line() as usize;
+        if let Some(s) = e.state {
+            let (line, s) = (line_of(&s), s.value);
             let known = s == "S0"
                 || self
                     .c
@@ -408,13 +402,8 @@ impl Resolver<'_> {
             }
             out.state = Some(s);
         }
-        if let Some(Spanned {
-            value: s,
-            referenced,
-            ..
-        }) = e.status
-        {
-            let line = referenced.line() as usize;
+        if let Some(s) = e.status {
+            let (line, s) = (line_of(&s), s.value);
             let i = self
                 .c
                 .statuses
@@ -423,13 +412,8 @@ impl Resolver<'_> {
                 .ok_or_else(|| err(line, format!("`{}` has no status `{s}`", self.c.name)))?;
             out.status = Some(i as u16);
         }
-        if let Some(Spanned {
-            value: x,
-            referenced,
-            ..
-        }) = e.error
-        {
-            let line = referenced.line() as usize;
+        if let Some(x) = e.error {
+            let (line, x) = (line_of(&x), x.value);
             out.error = Some(match x.as_str() {
                 "none" => None,
                 "UNKNOWN_COMMAND" => Some(rcs_runtime::ErrorCode::UNKNOWN_COMMAND.0),

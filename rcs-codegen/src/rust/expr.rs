@@ -114,15 +114,7 @@ fn int_lit(v: i128, t: &Type) -> Code {
     let lit: TokenStream = format!("{}{suffix}", v.unsigned_abs())
         .parse()
         .expect("integer literal");
-    if v < 0 {
-        Code {
-            ts: quote!(-#lit),
-            prec: UNARY,
-            has_block: false,
-        }
-    } else {
-        Code::atom(lit)
-    }
+    signed(lit, v < 0)
 }
 
 fn float_lit(v: f64, t: &Type) -> Code {
@@ -131,14 +123,20 @@ fn float_lit(v: f64, t: &Type) -> Code {
         _ => format!("{:?}f64", v.abs()),
     };
     let lit: TokenStream = text.parse().expect("float literal");
-    if v.is_sign_negative() && v != 0.0 {
+    signed(lit, v.is_sign_negative() && v != 0.0)
+}
+
+/// A literal of the magnitude, negated when `negative` (a unary minus
+/// expression, so that it is parenthesised where precedence needs it).
+fn signed(magnitude: TokenStream, negative: bool) -> Code {
+    if negative {
         Code {
-            ts: quote!(-#lit),
+            ts: quote!(-#magnitude),
             prec: UNARY,
             has_block: false,
         }
     } else {
-        Code::atom(lit)
+        Code::atom(magnitude)
     }
 }
 

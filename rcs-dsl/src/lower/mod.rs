@@ -483,9 +483,10 @@ fn lower_controller_headers<'a>(
                     let Some(bty) = bty else { continue };
                     let existing = ir.buffers.iter().position(|b| b.name == name.text);
                     let bid = match existing {
-                        Some(b) => {
-                            let (first, _) = buffer_decl[b];
-                            if ir.buffers[b].ty != bty {
+                        Some(b) if ir.buffers[b].ty == bty => BufferId(b as u32),
+                        found => {
+                            if let Some(b) = found {
+                                let (first, _) = buffer_decl[b];
                                 diags.push(
                                     Diagnostic::error(
                                         Code::BufferTypeConflict,
@@ -501,22 +502,11 @@ fn lower_controller_headers<'a>(
                                     .with_secondary(first, "first declared here")
                                     .with_help("a Global Memory buffer has one type across the plan set"),
                                 );
-                                // Inside this controller the buffer has the type
-                                // it declares: a stand-in entry keeps its uses
-                                // from cascading (no IR is produced anyway).
-                                ir.buffers.push(Buffer {
-                                    name: name.text.to_string(),
-                                    ty: bty,
-                                    writer: None,
-                                    readers: Vec::new(),
-                                });
-                                buffer_decl.push((name.span, None));
-                                BufferId(ir.buffers.len() as u32 - 1)
-                            } else {
-                                BufferId(b as u32)
                             }
-                        }
-                        None => {
+                            // A new buffer. After a type conflict it is a
+                            // stand-in: inside this controller the buffer has
+                            // the type it declares, which keeps its uses from
+                            // cascading (no IR is produced anyway).
                             ir.buffers.push(Buffer {
                                 name: name.text.to_string(),
                                 ty: bty,

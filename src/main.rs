@@ -343,6 +343,29 @@ fn test(args: TestArgs) -> ExitCode {
         Ok(irs) => irs,
         Err(code) => return code,
     };
+    // A run that tests nothing is a mistake (a wrong path, a misnamed
+    // folder), not a success.
+    if per_set.iter().all(Vec::is_empty) {
+        let looked: Vec<String> = sets
+            .iter()
+            .map(|s| format!("{}/scenarios/", s.root.trim_end_matches('/')))
+            .collect();
+        eprintln!(
+            "error: no scenarios to run (looked in {}); write `*.scenario.yaml` files there or name them",
+            looked.join(", ")
+        );
+        return ExitCode::from(1);
+    }
+    if !args.common.quiet {
+        let untested = sets.iter().zip(&irs).zip(&per_set);
+        for ((set, ir), _) in untested.filter(|(_, files)| files.is_empty()) {
+            eprintln!(
+                "warning: plan set `{}` has no scenarios (none under {}/scenarios/)",
+                ir.system,
+                set.root.trim_end_matches('/')
+            );
+        }
+    }
 
     let mut driver = None;
     if args.backend == test_cmd::Backend::Compiled {
@@ -576,7 +599,7 @@ fn build(args: BuildArgs) -> ExitCode {
         Err(code) => return code,
     };
 
-    let files = match output_files(&irs) {
+    let files = match output_files(&sets, &irs) {
         Ok(files) => files,
         Err(reason) => return fail(reason),
     };
@@ -601,28 +624,15 @@ fn build(args: BuildArgs) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-/// Every output of every plan set: the tree itself for one set, one
-/// `<system>/` folder per set for several.
-fn output_files(irs: &[rcs_dsl::ir::Ir]) -> Result<Vec<rcs_codegen::OutputFile>, String> {
-    if let [ir] = irs {
-        return Ok(rcs_codegen::generate(ir));
-    }
-    let mut files = Vec::new();
-    let mut systems: Vec<&str> = Vec::new();
-    for ir in irs {
-        if systems.contains(&ir.system.as_str()) {
-            return Err(format!(
-                "two plan sets are both named `{}`; build them separately or rename one (`system:` in rcs.yaml)",
-                ir.system
-            ));
-        }
-        systems.push(&ir.system);
-        files.extend(rcs_codegen::generate(ir).into_iter().map(|mut f| {
-            f.path = format!("{}/{}", ir.system, f.path);
-            f
-        }));
-    }
-    Ok(files)
+/// Every output of every plan set: the tree itself for one plan set named
+/// alone, one `<system>/` folder per set for a workspace or several sets.
+fn output_files(
+    sets: &[rcs_dsl::PlanSet],
+    irs: &[rcs_dsl::ir::Ir],
+) -> Result<Vec<rcs_codegen::OutputFile>, rcs_codegen::SameSystem> {
+    let irs: Vec<&rcs_dsl::ir::Ir> = irs.iter().collect();
+    let shared = rcs_dsl::load::shares_output(sets);
+    rcs_codegen::generate_sets(&irs, shared, &rcs_codegen::Options::default(), true)
 }
 
 /// Load and check plan sets for a command that prints a product on stdout
@@ -810,8 +820,16 @@ mod tests {
     #[test]
     fn several_sets_with_one_name_are_refused() {
         let ir = one_controller();
-        let one = output_files(std::slice::from_ref(&ir)).unwrap();
+        let set = rcs_dsl::PlanSet::default();
+        let one = output_files(std::slice::from_ref(&set), std::slice::from_ref(&ir)).unwrap();
         assert!(one.iter().any(|f| f.path == "graphs/hierarchy.dot"));
-        assert!(output_files(&[ir.clone(), ir]).is_err());
+        let member = rcs_dsl::PlanSet {
+            workspace: Some("plans".into()),
+            ..rcs_dsl::PlanSet::default()
+        };
+        let one = output_files(std::slice::from_ref(&member), std::slice::from_ref(&ir)).unwrap();
+        assert!(one.iter().any(|f| f.path == "a/graphs/hierarchy.dot"));
+        let two = [rcs_dsl::PlanSet::default(), rcs_dsl::PlanSet::default()];
+        assert!(output_files(&two, &[ir.clone(), ir]).is_err());
     }
 }

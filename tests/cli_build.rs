@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
 mod common;
-use common::{rcsc, rcsc_in, scratch, text};
+use common::{rcsc, rcsc_in, scratch, text, tree};
 
 /// A fresh, empty temporary folder for one test.
 fn temp(name: &str) -> PathBuf {
@@ -26,31 +26,6 @@ fn plan_set(dir: &Path, name: &str, files: &[(&str, &str)]) -> PathBuf {
 
 fn s(p: &Path) -> &str {
     p.to_str().expect("UTF-8 temp path")
-}
-
-/// Every file below `dir`: `/`-separated relative path → bytes.
-fn tree(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    if !dir.exists() {
-        return out;
-    }
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                let rel = p
-                    .strip_prefix(dir)
-                    .unwrap()
-                    .to_string_lossy()
-                    .replace('\\', "/");
-                out.insert(rel, std::fs::read(&p).unwrap());
-            }
-        }
-    }
-    out
 }
 
 fn mtimes(dir: &Path) -> BTreeMap<String, SystemTime> {

@@ -224,3 +224,36 @@ fn the_compiled_backend_gives_the_same_results_as_the_interpreter() {
     assert_eq!(compiled, interp);
     assert!(compiled.contains("fired: expected E2, got none"));
 }
+
+#[test]
+fn a_run_with_no_scenario_is_an_error_and_an_untested_set_a_warning() {
+    let go = "controller A {\n    command GO\n    plan GO { *0 when new_command -> Done }\n}\n";
+    let dir = scratch("no-scenarios", &[("ws/a/a.rcs", go)]);
+    let o = rcsc_in(&dir, &["test", "ws/a"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        text(&o.stderr).contains("error: no scenarios to run (looked in ws/a/scenarios/)"),
+        "{}",
+        text(&o.stderr)
+    );
+    // Beside a tested set, an untested one is a warning and the run goes on.
+    let fig = Path::new("plans/figure13");
+    for f in [
+        "figure13.rcs",
+        "scenarios/gx_principal_sequence.scenario.yaml",
+    ] {
+        let to = dir.join("ws/figure13").join(f);
+        std::fs::create_dir_all(to.parent().unwrap()).unwrap();
+        std::fs::copy(fig.join(f), to).unwrap();
+    }
+    let o = rcsc_in(&dir, &["test", "ws"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr)
+            .contains("warning: plan set `a` has no scenarios (none under ws/a/scenarios/)"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(text(&o.stdout).ends_with("1 passed, 0 failed\n"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -4,6 +4,9 @@
 //!   `rcs` block with no diagnostic at all, an `rcs expect=CODE, …` block with
 //!   exactly those codes (`rcs fragment` blocks are not checked); a
 //!   ```yaml expect=… block is the `rcs.yaml` of the `rcs` block before it;
+//!   a ```files expect=… block lists a folder layout (each `.rcs` file gets
+//!   a small clean controller, each `rcs.yaml` is empty), loaded from its
+//!   top folder as `rcsc` would;
 //! - every diagnostic code has an example and a section there;
 //! - `docs/ahead.svg`, the state graph shown in the README, is what
 //!   `rcsc graph plans/submarine --plan PR.AHEAD --format svg` draws today
@@ -95,6 +98,42 @@ fn check(rcs: &str, manifest: Option<&str>) -> (BTreeSet<String>, String) {
     (codes, text)
 }
 
+/// Lay out the files of a ```files block in a scratch folder and check
+/// every plan set its top folder holds; the codes found and their short
+/// rendering.
+fn check_layout(listing: &str, line: usize) -> (BTreeSet<String>, String) {
+    let dir = std::env::temp_dir().join(format!("rcsc-docs-layout-{}-{line}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut top = None;
+    for (i, path) in listing
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .enumerate()
+    {
+        let p = dir.join(path);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        let body = if path.ends_with(".rcs") {
+            format!("controller C{i} {{\n    command GO\n    plan GO {{ *0 when new_command -> Done }}\n}}\n")
+        } else {
+            String::new()
+        };
+        std::fs::write(&p, body).unwrap();
+        top.get_or_insert_with(|| dir.join(path.split('/').next().unwrap()));
+    }
+    let sets = rcs_dsl::load_paths(&[top.expect("a file")]).unwrap();
+    let mut codes = BTreeSet::new();
+    let mut text = String::new();
+    for set in &sets {
+        for d in rcs_dsl::check(set, &Options::default()).diagnostics {
+            codes.insert(d.code.name().to_string());
+            text.push_str(&render::render(&d, &set.sources, Format::Short));
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    (codes, text)
+}
+
 fn language_md() -> String {
     std::fs::read_to_string("docs/language.md").expect("docs/language.md exists")
 }
@@ -118,6 +157,17 @@ fn every_example_in_the_language_reference_checks_as_it_says() {
                     ));
                 }
                 previous_rcs = Some(b.text.clone());
+                checked += 1;
+            }
+            "files" => {
+                let want = b.expected().unwrap_or_default();
+                let (got, text) = check_layout(&b.text, b.line);
+                if got != want {
+                    failures.push(format!(
+                        "docs/language.md:{}: expected {want:?}, got {got:?}\n{text}",
+                        b.line
+                    ));
+                }
                 checked += 1;
             }
             "yaml" => match b.expected() {

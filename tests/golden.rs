@@ -81,14 +81,31 @@ fn case_name(case: &Path) -> String {
     case.file_stem().unwrap().to_string_lossy().into_owned()
 }
 
-/// Check one case; returns the plan set and its result.
-fn run(case: &Path) -> (rcs_dsl::PlanSet, rcs_dsl::Checked) {
-    let mut sets = rcs_dsl::load_paths(&[case.to_path_buf()])
+/// Check one case: every plan set it holds (a case folder may be a
+/// workspace) with its result.
+fn run(case: &Path) -> Vec<(rcs_dsl::PlanSet, rcs_dsl::Checked)> {
+    let sets = rcs_dsl::load_paths(&[case.to_path_buf()])
         .unwrap_or_else(|e| panic!("{}: {e}", case.display()));
-    assert_eq!(sets.len(), 1);
-    let set = sets.remove(0);
-    let checked = rcs_dsl::check(&set, &Options::default());
-    (set, checked)
+    assert!(!sets.is_empty(), "{}: no plan set", case.display());
+    sets.into_iter()
+        .map(|set| {
+            let checked = rcs_dsl::check(&set, &Options::default());
+            (set, checked)
+        })
+        .collect()
+}
+
+/// Every diagnostic of a case, rendered in `format`.
+fn rendered(results: &[(rcs_dsl::PlanSet, rcs_dsl::Checked)], format: Format) -> String {
+    results
+        .iter()
+        .flat_map(|(set, checked)| {
+            checked
+                .diagnostics
+                .iter()
+                .map(move |d| render::render(d, &set.sources, format))
+        })
+        .collect()
 }
 
 /// Every label of every diagnostic lies inside its file, on char boundaries.
@@ -112,18 +129,17 @@ fn assert_spans_inside(case: &Path, set: &rcs_dsl::PlanSet, checked: &rcs_dsl::C
 #[test]
 fn ok_cases_check_clean() {
     for case in cases("ok") {
-        let (set, checked) = run(&case);
-        let rendered: String = checked
-            .diagnostics
-            .iter()
-            .map(|d| render::render(d, &set.sources, Format::Short))
-            .collect();
-        assert!(
-            checked.diagnostics.is_empty(),
-            "{}:\n{rendered}",
-            case.display()
-        );
-        assert!(checked.ir.is_some(), "{}: no IR", case.display());
+        let results = run(&case);
+        let shown = rendered(&results, Format::Short);
+        assert!(shown.is_empty(), "{}:\n{shown}", case.display());
+        for (set, checked) in &results {
+            assert!(
+                checked.ir.is_some(),
+                "{} ({}): no IR",
+                case.display(),
+                set.name
+            );
+        }
     }
 }
 
@@ -131,38 +147,27 @@ fn ok_cases_check_clean() {
 fn err_cases_match_expectations_and_snapshots() {
     let mut problems = Vec::new();
     for case in cases("err") {
-        let (set, checked) = run(&case);
-        assert_spans_inside(&case, &set, &checked);
-        let got: BTreeSet<String> = checked
-            .diagnostics
+        let results = run(&case);
+        for (set, checked) in &results {
+            assert_spans_inside(&case, set, checked);
+        }
+        let got: BTreeSet<String> = results
             .iter()
+            .flat_map(|(_, checked)| &checked.diagnostics)
             .map(|d| d.code.name().to_string())
             .collect();
         let want = expected_codes(&case);
         if got != want {
-            let shown: String = checked
-                .diagnostics
-                .iter()
-                .map(|d| render::render(d, &set.sources, Format::Short))
-                .collect();
+            let shown = rendered(&results, Format::Short);
             problems.push(format!(
                 "{}: expected {want:?}, got {got:?}\n{shown}",
                 case.display()
             ));
             continue;
         }
-        let mut out = String::new();
-        for d in &checked.diagnostics {
-            out.push_str(&render::render(
-                d,
-                &set.sources,
-                Format::Human { color: false },
-            ));
-        }
+        let mut out = rendered(&results, Format::Human { color: false });
         out.push_str("---- json\n");
-        for d in &checked.diagnostics {
-            out.push_str(&render::render(d, &set.sources, Format::Json));
-        }
+        out.push_str(&rendered(&results, Format::Json));
         insta::with_settings!({
             snapshot_path => "data/err/snapshots",
             prepend_module_to_snapshot => false,

@@ -9,27 +9,34 @@
 //! ```
 //!
 //! and in the crate, `rcs_runtime::include_plans!("submarine");` includes
-//! `$OUT_DIR/rcs/rust/submarine.rs`.
+//! the generated module of the plan set named `submarine`.
 //!
-//! `compile` loads the plan-set folder (honouring its `rcs.yaml`), checks it
-//! and, when it has no error, writes every output of [`crate::generate`]
-//! through [`crate::writer::write_tree`] (so outputs it no longer produces
-//! are removed). It talks to cargo on stdout:
+//! `compile` loads a plan-set folder or a workspace of them (honouring each
+//! `rcs.yaml`, exactly as `rcsc build` does), checks every set and, when
+//! none has an error, writes every output of [`crate::generate`] through
+//! [`crate::writer::write_tree`] (so outputs it no longer produces are
+//! removed): one plan set into `$OUT_DIR/rcs/`, a workspace's sets into
+//! `$OUT_DIR/rcs/<system>/`, plus `include.rs`, which maps each compiled
+//! set's name to its file for `include_plans!` (and any other name to a
+//! compile error that lists them). It talks to cargo on stdout:
 //!
 //! - `cargo::rerun-if-changed=` for the folder, every input `.rcs` file and
-//!   the `rcs.yaml`;
+//!   every `rcs.yaml`;
 //! - one `cargo::warning=` line per warning (the short format);
 //! - on errors, the full human diagnostics on stderr, one `cargo::error=`
 //!   summary line, and `Err` (nothing is written).
 
 use crate::writer::{self, WriteError, WriteReport};
+use crate::{OutputFile, GENERATED};
 /// The lint names and levels of [`Config::lint`], re-exported so that a
 /// build script needs no direct dependency on `rcs-dsl`.
 pub use rcs_dsl::lint::{Level, Lint};
 use rcs_dsl::render::{self, Format};
 use rcs_dsl::{LoadError, Severity};
+use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 /// Settings of a build-script compilation. See the [module docs](self).
 #[derive(Clone, Debug)]
@@ -41,8 +48,10 @@ pub struct Config {
     options: crate::Options,
 }
 
-/// Why [`Config::compile`] failed. Its `Debug` is its message, so that a
-/// `build.rs` whose `main` returns the error prints one readable line.
+/// Why [`Config::compile`] failed. Its `Debug` is one readable line (for
+/// plan errors, a pointer to the diagnostics cargo shows), so that a
+/// `build.rs` whose `main` returns the error prints no struct dump and no
+/// third copy of the summary.
 #[derive(thiserror::Error)]
 pub enum CompileError {
     /// A variable cargo sets for build scripts is missing and no explicit
@@ -52,9 +61,9 @@ pub enum CompileError {
     /// The plan set could not be read at all.
     #[error(transparent)]
     Load(#[from] LoadError),
-    /// The path is not a single plan-set folder.
-    #[error("{0}: expected one plan-set folder, a `.rcs` file or an `rcs.yaml`")]
-    NotOneSet(String),
+    /// Two plan sets of one compilation have the same system name.
+    #[error(transparent)]
+    SameSystem(#[from] crate::SameSystem),
     /// The plans have errors; the diagnostics went to stderr.
     #[error("{summary}")]
     Diagnostics {
@@ -73,7 +82,16 @@ pub enum CompileError {
 
 impl std::fmt::Debug for CompileError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        std::fmt::Display::fmt(self, f)
+        match self {
+            // Cargo already shows the summary (the `cargo::error=` line) and
+            // the diagnostics; `main`'s `Error: …` need not repeat it.
+            CompileError::Diagnostics { errors, .. } => write!(
+                f,
+                "the plans have {errors} error{}, shown above",
+                if *errors == 1 { "" } else { "s" }
+            ),
+            _ => std::fmt::Display::fmt(self, f),
+        }
     }
 }
 
@@ -142,9 +160,10 @@ impl Config {
         self
     }
 
-    /// Check the plan set at `path` (a folder, relative to the manifest
-    /// directory) and write its outputs. Prints cargo instructions on stdout
-    /// and diagnostics on stderr.
+    /// Check the plan sets at `path` (a plan-set folder or a workspace of
+    /// them, relative to the manifest directory) and write their outputs.
+    /// Prints cargo instructions on stdout and diagnostics on stderr. Call it
+    /// once per folder; the outputs of earlier calls stay.
     pub fn compile(&self, path: impl AsRef<Path>) -> Result<WriteReport, CompileError> {
         let mut out = std::io::stdout().lock();
         let mut err = std::io::stderr().lock();
@@ -162,57 +181,56 @@ impl Config {
         let path = self.resolve(path)?;
         // Rerun on any change below the folder, even when loading fails.
         writeln!(cargo, "cargo::rerun-if-changed={}", path.display())?;
-        let mut sets = rcs_dsl::load_paths(std::slice::from_ref(&path))?;
-        if sets.len() != 1 {
-            return Err(CompileError::NotOneSet(path.display().to_string()));
-        }
-        let set = sets.remove(0);
-        let inputs = set.rcs_files.iter().chain(&set.manifest_file);
-        for id in inputs {
-            let name = &set.sources.get(*id).path;
-            if Path::new(name) != path {
-                writeln!(cargo, "cargo::rerun-if-changed={name}")?;
+        let sets = rcs_dsl::load_paths(std::slice::from_ref(&path))?;
+        for set in &sets {
+            for id in set.rcs_files.iter().chain(&set.manifest_file) {
+                let name = &set.sources.get(*id).path;
+                if Path::new(name) != path {
+                    writeln!(cargo, "cargo::rerun-if-changed={name}")?;
+                }
             }
         }
 
         let options = rcs_dsl::Options {
             lint_flags: self.lints.clone(),
         };
-        let checked = rcs_dsl::check(&set, &options);
         let mut errors = 0;
-        for d in &checked.diagnostics {
-            if d.severity == Severity::Error {
-                errors += 1;
-                let text = render::render(d, &set.sources, Format::Human { color: false });
-                diagnostics.write_all(text.as_bytes())?;
-            } else {
-                let text = render::render(d, &set.sources, Format::Short);
-                writeln!(cargo, "cargo::warning={}", one_line(&text))?;
+        let mut irs = Vec::with_capacity(sets.len());
+        for set in &sets {
+            let checked = rcs_dsl::check(set, &options);
+            for d in &checked.diagnostics {
+                if d.severity == Severity::Error {
+                    errors += 1;
+                    let text = render::render(d, &set.sources, Format::Human { color: false });
+                    diagnostics.write_all(text.as_bytes())?;
+                } else {
+                    let text = render::render(d, &set.sources, Format::Short);
+                    writeln!(cargo, "cargo::warning={}", one_line(&text))?;
+                }
             }
+            irs.extend(checked.ir);
         }
-        let ir = match checked.ir {
-            Some(ir) if errors == 0 => ir,
-            _ => {
-                let errors = errors.max(1);
-                let summary = format!(
-                    "could not compile the plans in `{}` due to {errors} error{}",
-                    path.display(),
-                    if errors == 1 { "" } else { "s" }
-                );
-                writeln!(diagnostics, "error: {summary}")?;
-                writeln!(cargo, "cargo::error={summary}")?;
-                return Err(CompileError::Diagnostics { summary, errors });
-            }
-        };
+        if errors > 0 || irs.len() != sets.len() {
+            let errors = errors.max(1);
+            let summary = format!(
+                "could not compile the plans in `{}` due to {errors} error{}",
+                path.display(),
+                if errors == 1 { "" } else { "s" }
+            );
+            // Cargo shows this line as the build's error and the full
+            // diagnostics (above, on stderr) under it; nothing repeats it.
+            writeln!(cargo, "cargo::error={summary}")?;
+            return Err(CompileError::Diagnostics { summary, errors });
+        }
 
-        let mut files = crate::generate_with(&ir, &self.options);
-        if !self.graphs {
-            files.retain(|f| !f.path.starts_with("graphs/") && !f.path.starts_with("tables/"));
-        }
+        let irs: Vec<&rcs_dsl::ir::Ir> = irs.iter().collect();
+        let shared = rcs_dsl::load::shares_output(&sets);
+        let files = crate::generate_sets(&irs, shared, &self.options, self.graphs)?;
         let out_dir = match &self.out_dir {
             Some(d) => d.clone(),
             None => PathBuf::from(env("OUT_DIR", "out_dir")?).join("rcs"),
         };
+        let files = produced_so_far(&out_dir, &path, files)?;
         Ok(writer::write_tree(&out_dir, &files)?)
     }
 
@@ -238,6 +256,98 @@ impl Config {
         })
     }
 }
+
+/// Everything the build script of this process generated into `out_dir`
+/// so far — the outputs of each plan-set folder it compiled there, those of
+/// `folder` now replaced by `files` — plus the `include.rs` that
+/// `rcs_runtime::include_plans!` reads. A build script may call
+/// [`Config::compile`] once per plan-set folder: each call writes the whole
+/// tree, so none removes the outputs of another as stale.
+fn produced_so_far(
+    out_dir: &Path,
+    folder: &Path,
+    files: Vec<OutputFile>,
+) -> Result<Vec<OutputFile>, crate::SameSystem> {
+    type Folders = BTreeMap<PathBuf, Vec<OutputFile>>;
+    static PRODUCED: Mutex<BTreeMap<PathBuf, Folders>> = Mutex::new(BTreeMap::new());
+    let mut produced = PRODUCED.lock().unwrap_or_else(|p| p.into_inner());
+    let folders = produced.entry(out_dir.to_path_buf()).or_default();
+    // Another folder's plan set of the same name would be overwritten.
+    for f in &files {
+        let Some(system) = rust_system(&f.path) else {
+            continue;
+        };
+        let others = folders.iter().filter(|(k, _)| k.as_path() != folder);
+        if others
+            .flat_map(|(_, fs)| fs)
+            .any(|g| rust_system(&g.path) == Some(system))
+        {
+            return Err(crate::SameSystem(system.to_string()));
+        }
+    }
+    folders.insert(folder.to_path_buf(), files);
+    let mut all: BTreeMap<&str, &OutputFile> = BTreeMap::new();
+    for f in folders.values().flatten() {
+        all.insert(&f.path, f);
+    }
+    let include = include_file(out_dir, all.keys().copied());
+    let mut all: Vec<OutputFile> = all.into_values().cloned().collect();
+    all.push(include);
+    Ok(all)
+}
+
+/// `submarine` for `rust/submarine.rs` or `submarine/rust/submarine.rs`.
+fn rust_system(path: &str) -> Option<&str> {
+    let (folder, file) = path.rsplit_once('/')?;
+    let system = file.strip_suffix(".rs")?;
+    (folder == "rust" || folder.strip_suffix("/rust") == Some(system)).then_some(system)
+}
+
+/// `include.rs`: the macro behind [`rcs_runtime::include_plans!`], one arm
+/// per plan set compiled into `out_dir`, and a clear error for any other
+/// name.
+fn include_file<'a>(out_dir: &Path, paths: impl Iterator<Item = &'a str>) -> OutputFile {
+    // Relative to `$OUT_DIR` where the folder is inside it (the default).
+    let base = std::env::var_os("OUT_DIR")
+        .and_then(|o| out_dir.strip_prefix(o).ok().map(Path::to_path_buf));
+    let mut arms = String::new();
+    let mut names = Vec::new();
+    for path in paths {
+        let Some(system) = rust_system(path) else {
+            continue;
+        };
+        let target = match &base {
+            Some(rel) => format!(
+                "concat!(env!(\"OUT_DIR\"), {:?})",
+                format!("/{}/{path}", rel.display()).replace("//", "/")
+            ),
+            None => format!("{:?}", out_dir.join(path).display().to_string()),
+        };
+        arms.push_str(&format!("    ({system:?}) => {{ include!({target}); }};\n"));
+        names.push(format!("`{system}`"));
+    }
+    let compiled = if names.is_empty() {
+        "none".to_string()
+    } else {
+        names.join(", ")
+    };
+    let contents = format!(
+        "// {GENERATED}: the plan sets this crate's build script compiled, for\n\
+         // `rcs_runtime::include_plans!`. Do not edit.\n\
+         #[allow(unused_macros)]\n\
+         macro_rules! __rcsc_plan_set {{\n\
+         {arms}    \
+         ($other:literal) => {{ ::core::compile_error!(::core::concat!(\"no plan set named `\", $other, \"`: this crate's build.rs compiled {compiled} (a plan set's name is its rcs.yaml `system:`, or its folder's name)\")); }};\n\
+         }}\n"
+    );
+    OutputFile {
+        path: INCLUDE_FILE.to_string(),
+        contents,
+    }
+}
+
+/// The file `include_plans!` reads, relative to the output folder.
+pub const INCLUDE_FILE: &str = "include.rs";
 
 fn env(name: &'static str, setter: &'static str) -> Result<String, CompileError> {
     std::env::var(name).map_err(|_| CompileError::MissingEnv(name, setter))
@@ -381,6 +491,100 @@ mod tests {
         );
         assert!(matches!(r, Err(CompileError::Load(_))));
         assert_eq!(cargo, "cargo::rerun-if-changed=DIR/plans\n");
+    }
+
+    const GO: &str = "controller A {\n    command GO\n    plan GO {\n        *0 when new_command -> Done\n    }\n}\n";
+
+    #[test]
+    fn a_workspace_compiles_every_plan_set_into_its_own_folder() {
+        let dir = scratch(
+            "workspace",
+            &[
+                ("one/a.rcs", GO),
+                ("two/a.rcs", GO),
+                ("two/rcs.yaml", "system: second\n"),
+            ],
+        );
+        let out = dir.join("out");
+        let (r, cargo, diags) = run(Config::new().manifest_dir(&dir).out_dir(&out), &dir);
+        r.unwrap();
+        assert_eq!(diags, "");
+        assert!(cargo.contains("cargo::rerun-if-changed=DIR/plans/two/rcs.yaml"));
+        assert!(out.join("one/rust/one.rs").is_file());
+        assert!(out.join("second/rust/second.rs").is_file());
+        assert!(out.join("second/graphs/A/GO.dot").is_file());
+        let include = std::fs::read_to_string(out.join(INCLUDE_FILE)).unwrap();
+        assert!(include.contains("(\"one\") => {"), "{include}");
+        assert!(include.contains("(\"second\") => {"), "{include}");
+        assert!(include.contains("compiled `one`, `second`"), "{include}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn two_calls_into_one_folder_keep_each_others_outputs() {
+        let dir = scratch(
+            "two-calls",
+            &[("one/a.rcs", GO), ("two/a.rcs", GO), ("two/rcs.yaml", "")],
+        );
+        let out = dir.join("out");
+        let config = Config::new().manifest_dir(&dir).out_dir(&out).clone();
+        let mut sink = Vec::new();
+        config
+            .compile_with_io(Path::new("plans/one"), &mut sink, &mut Vec::new())
+            .unwrap();
+        let report = config
+            .compile_with_io(Path::new("plans/two"), &mut sink, &mut Vec::new())
+            .unwrap();
+        assert!(report.removed.is_empty(), "{report:?}");
+        assert!(out.join("rust/one.rs").is_file());
+        assert!(out.join("rust/two.rs").is_file());
+        let include = std::fs::read_to_string(out.join(INCLUDE_FILE)).unwrap();
+        assert!(include.contains("compiled `one`, `two`"), "{include}");
+        // The same folder again replaces its own outputs.
+        let report = config
+            .compile_with_io(Path::new("plans/two"), &mut sink, &mut Vec::new())
+            .unwrap();
+        assert!(report.written.is_empty() && report.removed.is_empty());
+        // Another folder with a system name compiled before is refused.
+        std::fs::write(dir.join("plans/two/rcs.yaml"), "system: one\n").unwrap();
+        let err = config
+            .compile_with_io(Path::new("plans/two"), &mut sink, &mut Vec::new())
+            .unwrap_err();
+        assert!(matches!(err, CompileError::SameSystem(_)), "{err}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn two_sets_with_one_system_name_are_refused() {
+        let dir = scratch(
+            "same-name",
+            &[
+                ("one/a.rcs", GO),
+                ("one/rcs.yaml", "system: same\n"),
+                ("two/a.rcs", GO),
+                ("two/rcs.yaml", "system: same\n"),
+            ],
+        );
+        let out = dir.join("out");
+        let (r, _, _) = run(Config::new().manifest_dir(&dir).out_dir(&out), &dir);
+        let err = r.unwrap_err();
+        assert!(matches!(err, CompileError::SameSystem(_)), "{err}");
+        assert!(err.to_string().contains("both named `same`"), "{err}");
+        assert!(!out.exists(), "nothing written");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn the_error_main_prints_does_not_repeat_the_summary() {
+        let err = CompileError::Diagnostics {
+            summary: "could not compile the plans in `plans` due to 2 errors".into(),
+            errors: 2,
+        };
+        assert_eq!(format!("{err:?}"), "the plans have 2 errors, shown above");
+        assert_eq!(
+            err.to_string(),
+            "could not compile the plans in `plans` due to 2 errors"
+        );
     }
 
     #[test]

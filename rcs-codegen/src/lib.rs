@@ -88,3 +88,51 @@ pub fn generate_with(ir: &Ir, options: &Options) -> Vec<OutputFile> {
     }
     files
 }
+
+/// Where one plan set's outputs go in an output folder it may share with
+/// other sets: the folder itself for a plan set built alone, `<system>/`
+/// for the members of a workspace or several sets (see
+/// [`rcs_dsl::load::shares_output`]).
+pub fn set_folder(ir: &Ir, shared: bool) -> String {
+    if shared {
+        format!("{}/", ir.system)
+    } else {
+        String::new()
+    }
+}
+
+/// Two plan sets that would write the same `<system>/` folder.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "two plan sets are both named `{0}`; build them separately or rename one (`system:` in rcs.yaml)"
+)]
+pub struct SameSystem(pub String);
+
+/// Every output of several plan sets, each under its [`set_folder`]; with
+/// `docs: false`, the Rust code only (no graphs, no tables).
+pub fn generate_sets(
+    irs: &[&Ir],
+    shared: bool,
+    options: &Options,
+    docs: bool,
+) -> Result<Vec<OutputFile>, SameSystem> {
+    let mut files = Vec::new();
+    let mut systems: Vec<&str> = Vec::new();
+    for ir in irs {
+        if systems.contains(&ir.system.as_str()) {
+            return Err(SameSystem(ir.system.clone()));
+        }
+        systems.push(&ir.system);
+        let folder = set_folder(ir, shared);
+        files.extend(
+            generate_with(ir, options)
+                .into_iter()
+                .filter(|f| docs || f.path.starts_with("rust/"))
+                .map(|mut f| {
+                    f.path.insert_str(0, &folder);
+                    f
+                }),
+        );
+    }
+    Ok(files)
+}

@@ -50,12 +50,13 @@ pub enum Code {
     MultipleWriters,
     BufferTypeConflict,
     Manifest,
+    LooseFile,
     Lint(Lint),
 }
 
 impl Code {
     /// Every hard-error code, in catalogue order (lints follow in [`Lint::ALL`]).
-    pub const ERRORS: [Code; 20] = [
+    pub const ERRORS: [Code; 21] = [
         Code::Syntax,
         Code::DuplicateDefinition,
         Code::UnknownName,
@@ -76,6 +77,7 @@ impl Code {
         Code::MultipleWriters,
         Code::BufferTypeConflict,
         Code::Manifest,
+        Code::LooseFile,
     ];
 
     pub fn name(self) -> &'static str {
@@ -100,6 +102,7 @@ impl Code {
             Code::MultipleWriters => "multiple_writers",
             Code::BufferTypeConflict => "buffer_type_conflict",
             Code::Manifest => "manifest",
+            Code::LooseFile => "loose_file",
             Code::Lint(l) => l.name(),
         }
     }
@@ -127,6 +130,7 @@ impl Code {
             Code::MultipleWriters => "a buffer has two writers",
             Code::BufferTypeConflict => "one buffer name has two types",
             Code::Manifest => "`rcs.yaml` is malformed",
+            Code::LooseFile => "a `.rcs` file stands beside plan-set folders",
             Code::Lint(Lint::RuleOfTen) => "a plan has more rows than the rule of ten allows",
             Code::Lint(Lint::ShadowedRow) => "earlier rows always match before this row",
             Code::Lint(Lint::UnreachableState) => "no path from the entry reaches a state",

@@ -1,15 +1,23 @@
 //! Stage 0: paths on disk → [`PlanSet`]s (a [`SourceMap`] plus which file is
 //! the manifest). The only module of the front end that reads files.
 //!
-//! A folder is one plan set: its `rcs.yaml` (if any) decides which files
-//! belong to it, otherwise every `*.rcs` below it does. Loose `.rcs` files
-//! named together form one more set. Files are ordered by path so that the
-//! result never depends on the order the file system lists them in.
+//! As a Cargo package owns the files below its `Cargo.toml`, every
+//! `rcs.yaml` starts a plan set that owns the `*.rcs` files below it, up to
+//! the next `rcs.yaml` (or those its `plans:` names). A folder without a
+//! manifest whose subfolders hold plans is a *workspace*: each such
+//! subfolder is a plan set of its own (named after the folder), and `.rcs`
+//! files standing loose beside them are a `loose_file` error. A manifest
+//! with `workspace: [folders]` makes its folder a workspace of those
+//! folders. Any other folder is one plan set. Loose `.rcs` files named
+//! together on a command line form one more set. Files and sets are ordered
+//! by path so that the result never depends on the order the file system
+//! lists them in.
 
 use crate::diagnostic::{Code, Diagnostic};
 use crate::manifest::{self, Manifest};
 use crate::parser::MAX_FILE_BYTES;
 use crate::source::{FileId, SourceMap, Span};
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 /// A failure that is not a diagnostic: a path that cannot be read at all.
@@ -36,6 +44,10 @@ pub struct PlanSet {
     /// loose files and in-memory sets. Generated outputs name files
     /// relative to it, so they never depend on where the set lives.
     pub root: String,
+    /// The workspace folder the set was found in (`/`-separated), when it
+    /// was reached through a workspace or below another set rather than
+    /// named itself. `rcsc build` puts such sets into `DIR/<system>/`.
+    pub workspace: Option<String>,
     pub sources: SourceMap,
     /// The `.rcs` files, sorted by path.
     pub rcs_files: Vec<FileId>,
@@ -137,25 +149,32 @@ impl PlanSet {
     }
 }
 
-/// Load the plan sets named on a command line: each folder is a set; all
-/// loose `.rcs` files together are one more set (last).
+/// Load the plan sets named on a command line, in order: each folder stands
+/// for every plan set in it (see the module docs), and all loose `.rcs`
+/// files named together form one more set, last. A set reached twice (a
+/// workspace and one of its members both named) is loaded once.
 pub fn load_paths(paths: &[PathBuf]) -> Result<Vec<PlanSet>, LoadError> {
     let mut sets = Vec::new();
     let mut loose: Vec<PathBuf> = Vec::new();
     for path in paths {
         let meta = std::fs::metadata(path).map_err(|e| io_error(path, e))?;
         if meta.is_dir() {
-            sets.push(load_folder(path)?);
+            load_tree(path, None, &mut sets, 0)?;
         } else if path.extension().is_some_and(|e| e == "rcs") {
             loose.push(path.clone());
-        } else if path.file_name().is_some_and(|n| n == "rcs.yaml") {
-            sets.push(load_folder(path.parent().unwrap_or(Path::new(".")))?);
+        } else if path.file_name().is_some_and(|n| n == MANIFEST) {
+            load_tree(parent_folder(path), None, &mut sets, 0)?;
         } else {
             return Err(LoadError::NotPlan {
                 path: display(path),
             });
         }
     }
+    let mut seen = BTreeSet::new();
+    sets.retain(|set: &PlanSet| {
+        let key = std::fs::canonicalize(&set.root).unwrap_or_else(|_| PathBuf::from(&set.root));
+        seen.insert(key)
+    });
     if !loose.is_empty() {
         loose.sort();
         loose.dedup();
@@ -176,25 +195,231 @@ pub fn load_paths(paths: &[PathBuf]) -> Result<Vec<PlanSet>, LoadError> {
     Ok(sets)
 }
 
-/// Load one plan-set folder.
+/// Load exactly one plan-set folder: its `.rcs` files (honouring its
+/// `rcs.yaml`), without the plan sets nested below it. For tools that know
+/// they hold one set; [`load_paths`] is what the commands use.
 pub fn load_folder(root: &Path) -> Result<PlanSet, LoadError> {
-    let name = std::fs::canonicalize(root)
+    let mut nested = Vec::new();
+    let mut set = new_set(root, None);
+    let manifest_path = root.join(MANIFEST);
+    if manifest_path.is_file() {
+        set.read_manifest(&manifest_path)?;
+    }
+    set.collect_files(root, &mut nested)?;
+    Ok(set)
+}
+
+/// Whether the outputs of `sets` share one output folder, each set in a
+/// `<system>/` folder of its own: always, except for one plan set named
+/// alone (not reached through a workspace).
+pub fn shares_output(sets: &[PlanSet]) -> bool {
+    !matches!(sets, [one] if one.workspace.is_none())
+}
+
+const MANIFEST: &str = "rcs.yaml";
+
+/// How deep folders are searched for plan sets and `.rcs` files.
+const MAX_DEPTH: usize = 32;
+
+/// The folder of a file path (`.` for a bare file name).
+fn parent_folder(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+/// The plan sets in the tree at `dir`, appended to `sets` in path order.
+///
+/// - A folder with an `rcs.yaml` is a plan set owning the `.rcs` files below
+///   it, up to the next `rcs.yaml` (nested sets are loaded as sets of their
+///   own, never dropped) — unless the manifest has `workspace:`, which makes
+///   the folder a workspace of the folders it lists.
+/// - A folder without one whose subfolders hold `.rcs` files or manifests
+///   is a workspace: each such subfolder is loaded the same way. `.rcs`
+///   files directly in it stand loose beside those plan sets: an error.
+/// - Any other folder is one plan set named after it.
+fn load_tree(
+    dir: &Path,
+    workspace: Option<&str>,
+    sets: &mut Vec<PlanSet>,
+    depth: usize,
+) -> Result<(), LoadError> {
+    if depth > MAX_DEPTH {
+        return Ok(());
+    }
+    let manifest_path = dir.join(MANIFEST);
+    if manifest_path.is_file() {
+        let mut set = new_set(dir, workspace);
+        set.read_manifest(&manifest_path)?;
+        if let Some(members) = set.manifest.workspace.clone() {
+            let here = display(dir);
+            for (member, span) in members {
+                let p = dir.join(&member);
+                if p.is_dir() {
+                    load_tree(&p, Some(&here), sets, depth + 1)?;
+                } else {
+                    set.diagnostics.push(Diagnostic::error(
+                        Code::Manifest,
+                        format!("`workspace` names `{member}`, which is not a folder"),
+                        span,
+                        "no such folder",
+                    ));
+                }
+            }
+            // A workspace manifest has no plans; it is reported only when wrong.
+            if !set.diagnostics.is_empty() {
+                sets.push(set);
+            }
+            return Ok(());
+        }
+        let mut nested = Vec::new();
+        set.collect_files(dir, &mut nested)?;
+        let here = display(dir);
+        sets.push(set);
+        for n in nested {
+            load_tree(&n, Some(&here), sets, depth + 1)?;
+        }
+        return Ok(());
+    }
+
+    let (direct, subdirs) = list_folder(dir)?;
+    let mut members = Vec::new();
+    for sub in subdirs {
+        if holds_plans(&sub, depth + 1).map_err(|e| io_error(&sub, e))? {
+            members.push(sub);
+        }
+    }
+    if members.is_empty() {
+        let mut set = new_set(dir, workspace);
+        for p in direct {
+            set.add_file(&p)?;
+        }
+        sets.push(set);
+        return Ok(());
+    }
+    let here = display(dir);
+    if !direct.is_empty() {
+        let mut set = new_set(dir, workspace);
+        let names: Vec<String> = members
+            .iter()
+            .map(|m| format!("`{}/`", file_name(m)))
+            .collect();
+        for p in direct {
+            let id = set.add_file(&p)?;
+            set.diagnostics.push(
+                Diagnostic::error(
+                    Code::LooseFile,
+                    format!(
+                        "`{}` stands loose beside the plan-set folders {}",
+                        file_name(&p),
+                        names.join(", ")
+                    ),
+                    Span::new(id, 0, 0),
+                    "belongs to no plan set",
+                )
+                .with_note(format!(
+                    "`{here}` has no `rcs.yaml` and subfolders that hold plans, so it is a \
+                     workspace: each of those subfolders is a plan set of its own"
+                ))
+                .with_help(format!(
+                    "move the file into one of the plan-set folders, or add an `rcs.yaml` to \
+                     `{here}` to make the whole folder one plan set"
+                )),
+            );
+        }
+        sets.push(set);
+    }
+    for m in members {
+        load_tree(&m, Some(&here), sets, depth + 1)?;
+    }
+    Ok(())
+}
+
+fn new_set(dir: &Path, workspace: Option<&str>) -> PlanSet {
+    let name = std::fs::canonicalize(dir)
         .ok()
         .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
         .unwrap_or_else(|| "plans".to_string());
-    let mut set = PlanSet {
+    PlanSet {
         name,
-        root: display(root),
+        root: display(dir),
+        workspace: workspace.map(str::to_string),
         ..PlanSet::default()
-    };
-    let manifest_path = root.join("rcs.yaml");
-    if manifest_path.is_file() {
-        let bytes = read(&manifest_path)?;
+    }
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| display(path))
+}
+
+/// Whether an entry is hidden (`.git`, editor folders): never searched.
+fn hidden(name: &std::ffi::OsStr) -> bool {
+    name.to_string_lossy().starts_with('.')
+}
+
+/// The `.rcs` files directly in `dir` and its subfolders (not hidden, not
+/// through symlinks), each sorted.
+fn list_folder(dir: &Path) -> Result<(Vec<PathBuf>, Vec<PathBuf>), LoadError> {
+    let mut files = Vec::new();
+    let mut dirs = Vec::new();
+    let entries = std::fs::read_dir(dir).map_err(|e| io_error(dir, e))?;
+    for entry in entries {
+        let entry = entry.map_err(|e| io_error(dir, e))?;
+        let path = entry.path();
+        let ty = entry.file_type().map_err(|e| io_error(&path, e))?;
+        if hidden(&entry.file_name()) {
+            continue;
+        }
+        if ty.is_dir() {
+            dirs.push(path);
+        } else if is_rcs(&path, ty) {
+            files.push(path);
+        }
+    }
+    files.sort();
+    dirs.sort();
+    Ok((files, dirs))
+}
+
+fn is_rcs(path: &Path, ty: std::fs::FileType) -> bool {
+    (ty.is_file() || ty.is_symlink()) && path.extension().is_some_and(|e| e == "rcs")
+}
+
+/// Whether a `.rcs` file or an `rcs.yaml` lies anywhere below `dir`.
+fn holds_plans(dir: &Path, depth: usize) -> std::io::Result<bool> {
+    if depth > MAX_DEPTH {
+        return Ok(false);
+    }
+    for entry in std::fs::read_dir(dir)? {
+        let entry = entry?;
+        if hidden(&entry.file_name()) {
+            continue;
+        }
+        let path = entry.path();
+        let ty = entry.file_type()?;
+        if ty.is_dir() {
+            if holds_plans(&path, depth + 1)? {
+                return Ok(true);
+            }
+        } else if is_rcs(&path, ty) || entry.file_name() == MANIFEST {
+            return Ok(true);
+        }
+    }
+    Ok(false)
+}
+
+impl PlanSet {
+    /// Read and parse the set's manifest.
+    fn read_manifest(&mut self, path: &Path) -> Result<(), LoadError> {
+        let bytes = read(path)?;
         match String::from_utf8(bytes) {
-            Ok(text) => set.add_manifest(&display(&manifest_path), text),
+            Ok(text) => self.add_manifest(&display(path), text),
             Err(_) => {
-                let id = set.sources.add(display(&manifest_path), String::new());
-                set.diagnostics.push(Diagnostic::error(
+                let id = self.sources.add(display(path), String::new());
+                self.diagnostics.push(Diagnostic::error(
                     Code::Manifest,
                     "`rcs.yaml` is not valid UTF-8",
                     Span::new(id, 0, 0),
@@ -202,52 +427,94 @@ pub fn load_folder(root: &Path) -> Result<PlanSet, LoadError> {
                 ));
             }
         }
+        Ok(())
     }
-    let mut files: Vec<PathBuf> = Vec::new();
-    match set.manifest.plans.clone() {
-        Some(entries) => {
-            for (entry, span) in entries {
-                let p = root.join(&entry);
-                if p.is_dir() {
-                    collect_rcs(&p, &mut files, 0).map_err(|e| io_error(&p, e))?;
-                } else if p.is_file() {
-                    files.push(p);
-                } else {
-                    set.diagnostics.push(Diagnostic::error(
-                        Code::Manifest,
-                        format!("`plans` names `{entry}`, which does not exist"),
-                        span,
-                        "no such file or folder",
-                    ));
+
+    /// Read one `.rcs` file into the set.
+    fn add_file(&mut self, path: &Path) -> Result<FileId, LoadError> {
+        let bytes = read(path)?;
+        let id = self.add_bytes(display(path), bytes);
+        self.rcs_files.push(id);
+        Ok(id)
+    }
+
+    /// The set's `.rcs` files below `root` (those its manifest's `plans:`
+    /// names, or all of them), stopping at folders with their own manifest,
+    /// which go to `nested`.
+    fn collect_files(&mut self, root: &Path, nested: &mut Vec<PathBuf>) -> Result<(), LoadError> {
+        let mut files: Vec<PathBuf> = Vec::new();
+        match self.manifest.plans.clone() {
+            Some(entries) => {
+                // Nested sets are found by walking the whole folder either way.
+                let mut ignored = Vec::new();
+                collect_rcs(root, &mut ignored, nested, 0).map_err(|e| io_error(root, e))?;
+                for (entry, span) in entries {
+                    let p = root.join(&entry);
+                    if p.is_dir() && p.join(MANIFEST).is_file() && p != root {
+                        self.diagnostics.push(
+                            Diagnostic::error(
+                                Code::Manifest,
+                                format!(
+                                    "`plans` names `{entry}`, which has an `rcs.yaml` of its own"
+                                ),
+                                span,
+                                "a plan set of its own",
+                            )
+                            .with_help(
+                                "a folder with its own `rcs.yaml` is a separate plan set; \
+                                 remove it from `plans`, or remove its `rcs.yaml`",
+                            ),
+                        );
+                    } else if p.is_dir() {
+                        collect_rcs(&p, &mut files, &mut Vec::new(), 0)
+                            .map_err(|e| io_error(&p, e))?;
+                    } else if p.is_file() {
+                        files.push(p);
+                    } else {
+                        self.diagnostics.push(Diagnostic::error(
+                            Code::Manifest,
+                            format!("`plans` names `{entry}`, which does not exist"),
+                            span,
+                            "no such file or folder",
+                        ));
+                    }
                 }
             }
+            None => collect_rcs(root, &mut files, nested, 0).map_err(|e| io_error(root, e))?,
         }
-        None => collect_rcs(root, &mut files, 0).map_err(|e| io_error(root, e))?,
+        files.sort();
+        files.dedup();
+        for p in files {
+            self.add_file(&p)?;
+        }
+        Ok(())
     }
-    files.sort();
-    files.dedup();
-    for p in files {
-        let bytes = read(&p)?;
-        let id = set.add_bytes(display(&p), bytes);
-        set.rcs_files.push(id);
-    }
-    Ok(set)
 }
 
-/// Every `*.rcs` below `dir`, not following symlinked folders or hidden ones.
-fn collect_rcs(dir: &Path, out: &mut Vec<PathBuf>, depth: usize) -> std::io::Result<()> {
-    if depth > 32 {
+/// Every `*.rcs` below `dir`, not following symlinked folders or hidden
+/// ones; subfolders with their own manifest go to `nested` instead.
+fn collect_rcs(
+    dir: &Path,
+    out: &mut Vec<PathBuf>,
+    nested: &mut Vec<PathBuf>,
+    depth: usize,
+) -> std::io::Result<()> {
+    if depth > MAX_DEPTH {
         return Ok(());
     }
-    for entry in std::fs::read_dir(dir)? {
-        let entry = entry?;
+    let mut entries: Vec<_> = std::fs::read_dir(dir)?.collect::<Result<_, _>>()?;
+    entries.sort_by_key(|e| e.file_name());
+    for entry in entries {
         let path = entry.path();
         let ty = entry.file_type()?;
-        let hidden = entry.file_name().to_string_lossy().starts_with('.');
-        if ty.is_dir() && !hidden {
-            collect_rcs(&path, out, depth + 1)?;
-        } else if (ty.is_file() || ty.is_symlink()) && path.extension().is_some_and(|e| e == "rcs")
-        {
+        if hidden(&entry.file_name()) {
+            continue;
+        }
+        if ty.is_dir() && path.join(MANIFEST).is_file() {
+            nested.push(path);
+        } else if ty.is_dir() {
+            collect_rcs(&path, out, nested, depth + 1)?;
+        } else if is_rcs(&path, ty) {
             out.push(path);
         }
     }

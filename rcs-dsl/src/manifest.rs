@@ -20,6 +20,10 @@ pub struct Manifest {
     pub system: Option<(String, Span)>,
     /// `plans:` entries (files or folders relative to the manifest).
     pub plans: Option<Vec<(String, Span)>>,
+    /// `workspace:` entries: this manifest holds no plans of its own but
+    /// names the folders (relative to it) that hold plan sets, as a Cargo
+    /// virtual manifest lists its members.
+    pub workspace: Option<Vec<(String, Span)>>,
     pub limits: Limits,
     pub lints: Vec<LintOverride>,
     pub schedule: Option<Vec<CpuSpec>>,
@@ -40,6 +44,7 @@ pub struct CpuSpec {
 struct Raw {
     system: Option<Spanned<String>>,
     plans: Option<Vec<Spanned<String>>>,
+    workspace: Option<Spanned<Vec<Spanned<String>>>>,
     limits: Option<RawLimits>,
     lints: Option<BTreeMap<String, Spanned<String>>>,
     schedule: Option<Spanned<Vec<RawCpu>>>,
@@ -83,7 +88,7 @@ pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>>
             // The list of keys helps with a misplaced key, not with broken YAML.
             let d = if label == "unknown key" || label == "here" && message.contains("field") {
                 d.with_help(
-                    "known keys: system, plans, limits {max_rules_per_plan, max_subordinates}, \
+                    "known keys: system, plans, workspace, limits {max_rules_per_plan, max_subordinates}, \
                      lints {LINT: allow|warn|deny}, schedule [{cpu, period, order}]",
                 )
             } else {
@@ -103,8 +108,53 @@ pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>>
                 .map(|p| (p.value.clone(), spanned(&p.referenced)))
                 .collect()
         }),
+        workspace: raw.workspace.as_ref().map(|ws| {
+            ws.value
+                .iter()
+                .map(|w| (w.value.clone(), spanned(&w.referenced)))
+                .collect()
+        }),
         ..Manifest::default()
     };
+    if let Some(ws) = &raw.workspace {
+        let others = [
+            ("system", m.system.is_some()),
+            ("plans", m.plans.is_some()),
+            ("limits", raw.limits.is_some()),
+            ("lints", raw.lints.is_some()),
+            ("schedule", raw.schedule.is_some()),
+        ];
+        let others: Vec<&str> = others.iter().filter(|o| o.1).map(|o| o.0).collect();
+        if !others.is_empty() {
+            diags.push(
+                Diagnostic::error(
+                    Code::Manifest,
+                    format!(
+                        "a workspace manifest holds only `workspace:`, but this one also has {}",
+                        others
+                            .iter()
+                            .map(|k| format!("`{k}`"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                    key_span(file, id, spanned(&ws.referenced), "workspace"),
+                    "this makes the folder a workspace",
+                )
+                .with_help(
+                    "put the plan set's keys into the `rcs.yaml` of each member folder, \
+                     or drop `workspace:` to make this folder one plan set",
+                ),
+            );
+        }
+        if ws.value.is_empty() {
+            diags.push(Diagnostic::error(
+                Code::Manifest,
+                "`workspace:` lists no folders",
+                key_span(file, id, spanned(&ws.referenced), "workspace"),
+                "empty list",
+            ));
+        }
+    }
     if let Some((name, span)) = &m.system {
         if !is_identifier(name) {
             diags.push(

@@ -515,9 +515,40 @@ fn verb_call(
             let (k, a) = m.iter().next().expect("one entry");
             (k.as_str(), Some(a))
         }
+        Json::Bool(b) => return Err(err(line, yaml_boolean_verb(c, *b, shape()))),
         _ => return Err(err(line, shape())),
     };
     verb_args(ir, c, line, verb, args)
+}
+
+/// The message for a verb YAML read as a boolean (YAML 1.1 reads `ON`,
+/// `OFF`, `YES`, `NO`, `Y`, `N`, `TRUE` and `FALSE` so): which verb it
+/// probably was, and to quote it.
+fn yaml_boolean_verb(c: &Controller, value: bool, shape: String) -> String {
+    const WORDS: [(&str, bool); 8] = [
+        ("on", true),
+        ("yes", true),
+        ("y", true),
+        ("true", true),
+        ("off", false),
+        ("no", false),
+        ("n", false),
+        ("false", false),
+    ];
+    let verb = c.commands.iter().find(|k| {
+        WORDS
+            .iter()
+            .any(|(w, b)| *b == value && k.name.eq_ignore_ascii_case(w))
+    });
+    match verb {
+        Some(k) => format!(
+            "YAML reads `{0}` as the boolean `{value}`, not as the verb `{0}`: quote it, `\"{0}\"`",
+            k.name
+        ),
+        None => format!(
+            "{shape}, not the boolean `{value}` (YAML reads unquoted yes/no/on/off/true/false as booleans: quote such a verb)"
+        ),
+    }
 }
 
 fn verb_args(

@@ -203,18 +203,18 @@ pub use operator::{read_status, Operator};
 pub use plan::{Bookkeeping, NewCommand, SampleStats, Target, Tick, VerbStats};
 pub use trace::{read_trace, TraceRecord, TraceSink};
 
-/// Include the Rust code `rcsc` generated for a system from a build script.
+/// Include the Rust code `rcsc` generated for a plan set from a build script.
 ///
-/// `include_plans!("submarine")` expands to
-/// `include!(concat!(env!("OUT_DIR"), "/rcs/rust/submarine.rs"))`: the file
-/// `rcs_codegen::Config::compile` writes for the plan set whose system (the
-/// manifest's `system:`, or the folder's name) is `submarine`. Use it at
-/// module level.
+/// `include_plans!("submarine")` includes the module that
+/// `rcs_codegen::Config::compile` wrote under `$OUT_DIR/rcs/` for the plan
+/// set whose system (the manifest's `system:`, or the folder's name) is
+/// `submarine`. Use it at module level, once per plan set. A name the build
+/// script did not compile is a compile error that lists the names it did.
 ///
 /// ```ignore
 /// // build.rs (with `rcs-codegen` in [build-dependencies])
 /// fn main() -> Result<(), Box<dyn std::error::Error>> {
-///     rcs_codegen::Config::new().compile("plans/submarine")?;
+///     rcs_codegen::Config::new().compile("plans")?; // every plan set under plans/
 ///     Ok(())
 /// }
 ///
@@ -223,7 +223,12 @@ pub use trace::{read_trace, TraceRecord, TraceSink};
 /// ```
 #[macro_export]
 macro_rules! include_plans {
-    ($name:literal) => {
-        include!(concat!(env!("OUT_DIR"), "/rcs/rust/", $name, ".rs"));
+    // `tt`, not `literal`: a captured `literal` fragment is opaque and would
+    // match no arm of `__rcsc_plan_set!`.
+    ($name:tt) => {
+        // `Config::compile` writes this file: one `__rcsc_plan_set!` arm per
+        // plan set it compiled, and a `compile_error!` for any other name.
+        include!(concat!(env!("OUT_DIR"), "/rcs/include.rs"));
+        __rcsc_plan_set!($name);
     };
 }

@@ -1,6 +1,7 @@
 //! What the end-to-end tests of the `rcsc` binary share: running it, its
-//! output as text, and scratch plan-set folders.
+//! output as text, scratch plan-set folders and what a build left in one.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -40,4 +41,30 @@ pub fn scratch(name: &str, files: &[(&str, &str)]) -> PathBuf {
         std::fs::write(p, body).unwrap();
     }
     dir
+}
+
+/// Every file below `dir`: `/`-separated relative path → bytes.
+#[allow(dead_code)] // each test binary compiles this module; not all use it
+pub fn tree(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    if !dir.exists() {
+        return out;
+    }
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let rel = p
+                    .strip_prefix(dir)
+                    .unwrap()
+                    .to_string_lossy()
+                    .replace('\\', "/");
+                out.insert(rel, std::fs::read(&p).unwrap());
+            }
+        }
+    }
+    out
 }

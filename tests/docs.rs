@@ -11,7 +11,7 @@
 //! - `docs/ahead.svg`, the state graph shown in the README, is what
 //!   `rcsc graph plans/submarine --plan PR.AHEAD --format svg` draws today
 //!   (`UPDATE_DOCS=1 cargo test --test docs` rewrites it);
-//! - the README gives the two commands of the project, and its example
+//! - the README gives the install, build and test commands, and its example
 //!   scenario passes on the submarine plans.
 
 use rcs_dsl::lint::Lint;
@@ -232,15 +232,16 @@ fn every_diagnostic_code_has_a_section_and_an_example() {
 }
 
 #[test]
-fn the_readme_gives_the_two_commands() {
+fn the_readme_gives_install_build_and_test_commands() {
     let readme = std::fs::read_to_string("README.md").unwrap();
     let commands: Vec<&str> = readme
         .lines()
         .map(|l| l.split('#').next().unwrap_or("").trim())
-        .filter(|l| l.starts_with("cargo "))
+        .filter(|l| l.starts_with("cargo ") || l.starts_with("rcsc "))
         .collect();
     for want in [
-        "cargo run --release -- build plans/submarine",
+        "cargo install --locked --path .",
+        "rcsc build plans/",
         "cargo test --workspace",
     ] {
         assert!(

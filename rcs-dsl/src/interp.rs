@@ -10,12 +10,14 @@
 //! (or `MIN / -1`) gives 0, `f32` arithmetic is rounded to `f32`, and `as`
 //! behaves like Rust's (integers keep their low bits, floats saturate).
 
-use crate::ast::{AssignOp, BinOp, UnOp};
+use crate::ast::{AssignOp, BinOp};
 use crate::ir::*;
 use rcs_runtime::{
     Bookkeeping, ErrorCode, Stamped, Status, StatusBuffer, SubordinateLink, SubordinateView, Tick,
 };
 
+use crate::arith::truthy;
+pub use crate::arith::{checked, float_to_int, round, wrap};
 pub use rcs_runtime::driver::Value;
 
 /// The zero value of a type: numbers 0, `false`, the first variant.
@@ -76,49 +78,6 @@ pub fn conform(ir: &Ir, t: &Type, v: &Value) -> Option<Value> {
         (Type::Unit, Value::Unit) => Value::Unit,
         _ => return None,
     })
-}
-
-fn truthy(v: &Value) -> bool {
-    matches!(v, Value::Bool(true))
-}
-
-/// An integer wrapped into the range of its type (keeps the low bits).
-pub fn wrap(v: i128, t: IntTy) -> i128 {
-    let bits = match t {
-        IntTy::I8 | IntTy::U8 => 8,
-        IntTy::I16 | IntTy::U16 => 16,
-        IntTy::I32 | IntTy::U32 => 32,
-        IntTy::I64 | IntTy::U64 => 64,
-    };
-    let masked = (v as u128) & ((1u128 << bits) - 1);
-    if t.signed() && masked >> (bits - 1) == 1 {
-        masked as i128 - (1i128 << bits)
-    } else {
-        masked as i128
-    }
-}
-
-fn round(v: f64, t: FloatTy) -> f64 {
-    match t {
-        FloatTy::F32 => v as f32 as f64,
-        FloatTy::F64 => v,
-    }
-}
-
-/// Rust's `as` from a float to an integer: truncate, saturate, NaN → 0.
-pub fn float_to_int(v: f64, t: IntTy) -> i128 {
-    if v.is_nan() {
-        return 0;
-    }
-    let (lo, hi) = t.range();
-    let t = v.trunc();
-    if t <= lo as f64 {
-        lo
-    } else if t >= hi as f64 {
-        hi
-    } else {
-        t as i128
-    }
 }
 
 /// What a hook sees of its controller, read-only (as generated hooks see `&Data`).
@@ -442,10 +401,7 @@ impl<'ir> Interpreter<'ir> {
     pub fn eval(&mut self, e: &Expr, hooks: &mut dyn Hooks) -> Value {
         match &e.kind {
             ExprKind::Int(v) => Value::Int(*v),
-            ExprKind::Float(v) => Value::Float(match e.ty {
-                Type::Float(t) => round(*v, t),
-                _ => *v,
-            }),
+            ExprKind::Float(v) => Value::Float(crate::arith::float_literal(*v, &e.ty)),
             ExprKind::Bool(b) => Value::Bool(*b),
             ExprKind::Variant(_, v) => Value::Enum(*v),
             ExprKind::Status(s) => Value::Status(s.0 as u16),
@@ -503,24 +459,11 @@ impl<'ir> Interpreter<'ir> {
             }
             ExprKind::Unary(op, x) => {
                 let v = self.eval(x, hooks);
-                match (op, v, &e.ty) {
-                    (UnOp::Not, Value::Bool(b), _) => Value::Bool(!b),
-                    (UnOp::Neg, Value::Int(i), Type::Int(t)) => {
-                        Value::Int(wrap(i.wrapping_neg(), *t))
-                    }
-                    (UnOp::Neg, Value::Float(f), _) => Value::Float(-f),
-                    (_, v, _) => v,
-                }
+                crate::arith::unary(*op, v, &e.ty)
             }
             ExprKind::Cast(x) => {
                 let v = self.eval(x, hooks);
-                match (v, &e.ty) {
-                    (Value::Int(i), Type::Int(t)) => Value::Int(wrap(i, *t)),
-                    (Value::Int(i), Type::Float(t)) => Value::Float(round(i as f64, *t)),
-                    (Value::Float(f), Type::Int(t)) => Value::Int(float_to_int(f, *t)),
-                    (Value::Float(f), Type::Float(t)) => Value::Float(round(f, *t)),
-                    (v, _) => v,
-                }
+                crate::arith::cast(v, &e.ty)
             }
             ExprKind::Binary(op, l, r) => self.binary(*op, l, r, &e.ty, hooks),
         }
@@ -538,59 +481,8 @@ impl<'ir> Interpreter<'ir> {
         }
         let a = self.eval(l, hooks);
         let b = self.eval(r, hooks);
-        match op {
-            BinOp::Eq => Value::Bool(a == b),
-            BinOp::Ne => Value::Bool(a != b),
-            BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge => {
-                let ord = match (&a, &b) {
-                    (Value::Int(x), Value::Int(y)) => x.partial_cmp(y),
-                    (Value::Float(x), Value::Float(y)) => x.partial_cmp(y),
-                    _ => None,
-                };
-                Value::Bool(match (op, ord) {
-                    (_, None) => false,
-                    (BinOp::Lt, Some(o)) => o.is_lt(),
-                    (BinOp::Le, Some(o)) => o.is_le(),
-                    (BinOp::Gt, Some(o)) => o.is_gt(),
-                    (_, Some(o)) => o.is_ge(),
-                })
-            }
-            _ => match (a, b, ty) {
-                (Value::Int(x), Value::Int(y), Type::Int(t)) => Value::Int(wrap(
-                    match op {
-                        BinOp::Add => x.wrapping_add(y),
-                        BinOp::Sub => x.wrapping_sub(y),
-                        BinOp::Mul => x.wrapping_mul(y),
-                        // The generated code's `checked_div(..).unwrap_or(0)`:
-                        // zero for a zero divisor and for `MIN / -1`.
-                        BinOp::Div => checked(x, y, *t, i128::checked_div),
-                        _ => checked(x, y, *t, i128::checked_rem),
-                    },
-                    *t,
-                )),
-                (Value::Float(x), Value::Float(y), Type::Float(t)) => Value::Float(round(
-                    match op {
-                        BinOp::Add => x + y,
-                        BinOp::Sub => x - y,
-                        BinOp::Mul => x * y,
-                        BinOp::Div => x / y,
-                        _ => x % y,
-                    },
-                    *t,
-                )),
-                (a, _, _) => a,
-            },
-        }
+        crate::arith::binary(op, a, b, ty)
     }
-}
-
-/// Integer division or remainder with Rust's checked semantics at width `t`.
-fn checked(x: i128, y: i128, t: IntTy, f: fn(i128, i128) -> Option<i128>) -> i128 {
-    let (lo, _) = t.range();
-    if y == 0 || (t.signed() && x == lo && y == -1) {
-        return 0;
-    }
-    f(x, y).unwrap_or(0)
 }
 
 /// Hooks for constant contexts (var initialisers call none).

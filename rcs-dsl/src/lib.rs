@@ -4,6 +4,7 @@
 //!
 //! ```text
 //! paths ──load──▶ PlanSet ──parse──▶ ast::File ──lower──▶ ir::Ir ──checks──▶ findings
+//!                                                               (asking analysis)
 //! ```
 //!
 //! [`check`] runs it. Each stage reports all of its errors and the pipeline
@@ -15,6 +16,8 @@
 // derive then names `alloc` from the crate root.
 extern crate alloc;
 
+pub mod analysis;
+pub mod arith;
 pub mod ast;
 mod checks;
 pub mod diagnostic;
@@ -63,6 +66,28 @@ impl Checked {
 /// Check a loaded plan set: parse, lower, validate.
 pub fn check(set: &PlanSet, options: &Options) -> Checked {
     let mut diags = Diagnostics::new();
+    let Some(ir) = front(set, &mut diags) else {
+        return finish(None, diags);
+    };
+    let mut levels = LintLevels::default();
+    for &(lint, level) in set.manifest.lints.iter().chain(&options.lint_flags) {
+        levels.set(lint, level);
+    }
+    checks::run(&ir, &levels, &set.sources, &mut diags);
+    let ir = (!diags.has_errors()).then_some(ir);
+    finish(ir, diags)
+}
+
+/// Parse and lower a plan set without running the checks: the IR even of
+/// plans a check rejects (a shadowed row, an unreachable one), `None` only
+/// when parsing or lowering fails. For tools and tests that study such
+/// plans; everything else wants [`check`].
+pub fn lower_unchecked(set: &PlanSet) -> Option<ir::Ir> {
+    front(set, &mut Diagnostics::new())
+}
+
+/// Stages 0–2: the load diagnostics, parsing and lowering.
+fn front(set: &PlanSet, diags: &mut Diagnostics) -> Option<ir::Ir> {
     // Stage 0 (load and manifest) and stage 1 (parse) are independent, so
     // their errors are reported together.
     let unreadable: Vec<source::FileId> = set
@@ -89,9 +114,8 @@ pub fn check(set: &PlanSet, options: &Options) -> Checked {
     }
     diags.sort_from(start, &set.sources);
     if diags.has_errors() {
-        return finish(None, diags);
+        return None;
     }
-
     let system = set
         .manifest
         .system
@@ -103,24 +127,15 @@ pub fn check(set: &PlanSet, options: &Options) -> Checked {
         .files()
         .map(|(id, _)| set.relative_path(id))
         .collect();
-    let Some(ir) = lower::lower(
+    let ir = lower::lower(
         &files,
         file_names,
         &set.manifest,
         &system,
         &set.sources,
-        &mut diags,
-    ) else {
-        return finish(None, diags);
-    };
-
-    let mut levels = LintLevels::default();
-    for &(lint, level) in set.manifest.lints.iter().chain(&options.lint_flags) {
-        levels.set(lint, level);
-    }
-    checks::run(&ir, &levels, &set.sources, &mut diags);
-    let ir = (!diags.has_errors()).then_some(ir);
-    finish(ir, diags)
+        diags,
+    );
+    ir.filter(|_| !diags.has_errors())
 }
 
 type Parsed = Result<ast::File, Vec<Diagnostic>>;

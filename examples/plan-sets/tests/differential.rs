@@ -85,11 +85,14 @@ const NEVER_FIRE: &[(&str, &str, &str, u32, &str)] = &[
     (OK_0018, "A", "GO", 9, "S8: reached only through row 0"),
     (OK_0018, "A", "GO", 10, "`*10 when state_cycles > 100`: row 1 ends every GO on its first cycle"),
     (OK_0018, "A", "GO", 11, "S1: reached only through row 0"),
+    (OK_0107, "H", "ARGS", 2, "`reading(1) == Mid && reading(2) == Low`: the scripted hooks answer one value per hook, whatever the arguments"),
+    (OK_0107, "H", "ARGS", 3, "`reading(2) == Low` after `reading(1) == Low`: one scripted value per hook (see row 2)"),
 ];
 const OK_0009: &str = "tests/data/ok/0009_targets_and_otherwise.rcs";
 const OK_0011: &str = "tests/data/ok/0011_otherwise_never_shadowed.rcs";
 const OK_0017: &str = "tests/data/ok/0017_lint_levels";
 const OK_0018: &str = "tests/data/ok/0018_allowed_lints_and_bare_initialisers.rcs";
+const OK_0107: &str = "tests/data/ok/0107_analysis_hooks_and_arguments.rcs";
 
 // ---------------------------------------------------------------- inputs
 
@@ -199,11 +202,23 @@ struct Values<'a> {
 impl<'a> Values<'a> {
     fn new(ir: &'a Ir, c: &Controller) -> Values<'a> {
         let mut ints = vec![0i128, 1, -1];
-        let mut floats = vec![0.0f64, -0.0, 1.0, -1.0, 0.5, -0.5];
+        // NaN and the infinities: rows must agree on them too (and some
+        // rows fire only for them: a NaN matches no ordering comparison).
+        let mut floats = vec![
+            0.0f64,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            -0.5,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
         let mut harvest = |e: &rcs_dsl::ir::Expr| match e.kind {
             ExprKind::Int(v) => {
                 for x in [v, -v] {
-                    ints.extend([x - 1, x, x + 1]);
+                    ints.extend([x.saturating_sub(1), x, x.saturating_add(1)]);
                     floats.extend([x as f64 - 1.0, x as f64, x as f64 + 1.0]);
                 }
             }
@@ -211,7 +226,7 @@ impl<'a> Values<'a> {
                 for x in [v, -v] {
                     floats.extend([x - 1.0, x, x + 1.0]);
                     let t = x.trunc() as i128;
-                    ints.extend([t - 1, t, t + 1]);
+                    ints.extend([t.saturating_sub(1), t, t.saturating_add(1)]);
                 }
             }
             _ => {}

@@ -1,14 +1,16 @@
 //! The plan graph (states as nodes, rows as edges) on petgraph, and the
 //! checks that walk it: `unreachable_state`, `dead_end_state`, `no_done`.
 //!
-//! The graph starts at `S0`. A row with `new_command` as a top-level
-//! conjunct is an edge from `S0` only; any other don't-care row (and
-//! `otherwise`) is an edge from every state; `same` never leaves a state.
-//! Rows that can never match (see `plan::never_matches`) add no edge.
+//! The graph starts at `S0` and holds only rows that can fire: a row is an
+//! edge from each state in which the analysis of conditions cannot rule out
+//! that it fires (so a row testing `new_command` leaves `S0` only, a row
+//! that earlier rows always take first adds no edge, and a shadowed exit
+//! no longer hides a dead end); `same` never leaves a state.
 
 use super::Sink;
+use crate::analysis::PlanAnalysis;
 use crate::diagnostic::Diagnostic;
-use crate::ir::{Controller, From, Ir, Plan, StateId, Target};
+use crate::ir::{Controller, Ir, Plan, StateId, Target};
 use crate::lint::Lint;
 use petgraph::graph::{DiGraph, NodeIndex};
 use petgraph::visit::{Bfs, Walker};
@@ -21,19 +23,21 @@ pub(crate) struct Analysis {
     pub leaves: Vec<bool>,
     /// `Done` or `Error` is reachable from `S0`.
     pub ends: bool,
-    /// Per row: judged unable to match by its own `from` and condition.
+    /// Per row: proved unable to match by its own `from` and condition.
     pub never_matches: Vec<bool>,
 }
 
-pub(crate) fn analyse(p: &Plan) -> Analysis {
+pub(crate) fn analyse(p: &Plan, conditions: &PlanAnalysis) -> Analysis {
     let n = p.states.len();
     let mut g: DiGraph<(), ()> = DiGraph::with_capacity(n + 2, p.rows.len() * 2);
     for _ in 0..n + 2 {
         g.add_node(());
     }
     let (done, error) = (NodeIndex::new(n), NodeIndex::new(n + 1));
-    let never_matches: Vec<bool> = p.rows.iter().map(super::plan::never_matches).collect();
-    for (row, never) in p.rows.iter().zip(&never_matches) {
+    let never_matches: Vec<bool> = (0..p.rows.len())
+        .map(|i| conditions.can_match(i).is_never())
+        .collect();
+    for (i, (row, never)) in p.rows.iter().zip(&never_matches).enumerate() {
         if *never {
             continue;
         }
@@ -43,13 +47,12 @@ pub(crate) fn analyse(p: &Plan) -> Analysis {
             Target::Done => done,
             Target::Error(_) => error,
         };
-        let froms: Vec<usize> = match row.from {
-            _ if row.is_entry => vec![StateId::S0.index()],
-            From::State(s) => vec![s.index()],
-            From::DontCare(_) => (0..n).collect(),
-        };
-        for f in froms {
-            if NodeIndex::new(f) != to {
+        // An edge from each state the row can fire in: a row that earlier
+        // rows always take first there (or that needs `new_command`
+        // outside S0) adds none.
+        for f in 0..n {
+            let state = StateId(f as u32);
+            if NodeIndex::new(f) != to && !conditions.can_fire_in(i, state).is_never() {
                 g.add_edge(NodeIndex::new(f), to, ());
             }
         }

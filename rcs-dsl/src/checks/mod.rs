@@ -91,9 +91,10 @@ pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagno
             plan::check_entry(p, &mut sink);
             plan::check_double_commands(ir, p, &mut sink);
             plan::check_rule_of_ten(ir, c, p, &mut sink);
-            let analysis = graph::analyse(p);
+            let conditions = crate::analysis::PlanAnalysis::new(ir, c, p);
+            let analysis = graph::analyse(p, &conditions);
             plan::check_unreachable_rows(p, &analysis, &mut sink);
-            plan::check_shadowed_rows(c, p, &analysis, &mut sink);
+            plan::check_shadowed_rows(c, p, &analysis, &conditions, &mut sink);
             graph::check_unreachable_states(c, p, &analysis, &mut sink);
             graph::check_dead_ends(c, p, &analysis, &mut sink);
             graph::check_no_done(ir, c, p, &analysis, &mut sink);

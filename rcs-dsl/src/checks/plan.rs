@@ -4,6 +4,7 @@
 
 use super::graph::Analysis;
 use super::Sink;
+use crate::analysis::PlanAnalysis;
 use crate::diagnostic::{Code, Diagnostic};
 use crate::ir::{Condition, Controller, Expr, ExprKind, From, Ir, Job, Plan, Row, StateId};
 use crate::lint::Lint;
@@ -153,15 +154,6 @@ pub(crate) fn check_entry(p: &Plan, sink: &mut Sink) {
     }
 }
 
-/// Whether a row can never match, judged by its own `from` and condition.
-pub(crate) fn never_matches(r: &Row) -> bool {
-    let from_later_state = matches!(r.from, From::State(s) if s != StateId::S0);
-    match &r.cond {
-        Condition::Otherwise => false,
-        Condition::When(c) => (r.is_entry && from_later_state) || has_false_conjunct(c),
-    }
-}
-
 fn has_false_conjunct(e: &Expr) -> bool {
     match &e.kind {
         ExprKind::Bool(false) => true,
@@ -199,7 +191,7 @@ pub(crate) fn check_unreachable_rows(p: &Plan, a: &Analysis, sink: &mut Sink) {
             )
             .with_note("a new command resets the plan to S0 before the rows run")
             .with_help("start the row from `*` or `S0`")
-        } else {
+        } else if has_false_conjunct(c) {
             Diagnostic::error(
                 Code::UnreachableRow,
                 format!(
@@ -210,84 +202,97 @@ pub(crate) fn check_unreachable_rows(p: &Plan, a: &Analysis, sink: &mut Sink) {
                 "`false` is a conjunct of this condition",
             )
             .with_help("remove the row, or fix its condition")
+        } else {
+            Diagnostic::error(
+                Code::UnreachableRow,
+                format!(
+                    "row {} can never match: no inputs make its condition true",
+                    r.display_name()
+                ),
+                c.span,
+                "always false",
+            )
+            .with_note(
+                "decided over every value the inputs can take: the ranges of their types, \
+                 every enum variant and subordinate status, NaN for floats",
+            )
+            .with_help("remove the row, or fix its condition")
         };
         sink.error(d);
     }
 }
 
-/// Structural equality of conditions (spans ignored).
-fn same_expr(a: &Expr, b: &Expr) -> bool {
-    use ExprKind::*;
-    if a.ty != b.ty {
-        return false;
-    }
-    match (&a.kind, &b.kind) {
-        (Int(x), Int(y)) => x == y,
-        (Float(x), Float(y)) => x.to_bits() == y.to_bits(),
-        (Bool(x), Bool(y)) => x == y,
-        (Variant(e, v), Variant(f, w)) => e == f && v == w,
-        (Status(x), Status(y)) => x == y,
-        (NewCommand, NewCommand) | (StateCycles, StateCycles) | (PlanCycles, PlanCycles) => true,
-        (CmdParam(c, p), CmdParam(d, q)) => c == d && p == q,
-        (Var(x), Var(y)) => x == y,
-        (Buffer(x), Buffer(y)) => x == y,
-        (Field(x, i), Field(y, j)) | (Index(x, i), Index(y, j)) => i == j && same_expr(x, y),
-        (Call(h, xs), Call(k, ys)) => {
-            h == k && xs.len() == ys.len() && xs.iter().zip(ys).all(|(x, y)| same_expr(x, y))
-        }
-        (Sub(c, p), Sub(d, q)) => c == d && p == q,
-        (Unary(o, x), Unary(p, y)) => o == p && same_expr(x, y),
-        (Binary(o, x1, x2), Binary(p, y1, y2)) => o == p && same_expr(x1, y1) && same_expr(x2, y2),
-        (Cast(x), Cast(y)) => same_expr(x, y),
-        _ => false,
-    }
-}
-
-/// An earlier row whose state pattern covers this one's and whose condition
-/// is `true` or the same as this one's always matches first.
-pub(crate) fn check_shadowed_rows(c: &Controller, p: &Plan, a: &Analysis, sink: &mut Sink) {
+/// A row that, in every reachable state it applies to, some earlier rows
+/// always take first: the union of the earlier rows covering that state
+/// matches whenever this one does. Decided by the analysis of conditions,
+/// so implication, several rows together, enum and status exhaustion and
+/// integer ranges all count; the earlier rows that can match together with
+/// this one are named.
+pub(crate) fn check_shadowed_rows(
+    c: &Controller,
+    p: &Plan,
+    a: &Analysis,
+    conditions: &PlanAnalysis,
+    sink: &mut Sink,
+) {
     for (j, later) in p.rows.iter().enumerate() {
-        let Condition::When(cond) = &later.cond else {
-            continue;
-        };
-        if a.never_matches[j] || !from_reachable(later, a) {
+        if later.is_otherwise() || a.never_matches[j] {
             continue;
         }
-        let shadow = p.rows[..j].iter().find(|earlier| {
-            let Condition::When(ec) = &earlier.cond else {
-                return false;
-            };
-            if a.never_matches[earlier.position as usize] {
-                return false;
-            }
-            let covers = match (&earlier.from, &later.from) {
-                (From::DontCare(_), _) => true,
-                (From::State(x), From::State(y)) => x == y,
-                (From::State(_), From::DontCare(_)) => false,
-            };
-            covers && (matches!(ec.kind, ExprKind::Bool(true)) || same_expr(ec, cond))
-        });
-        if let Some(e) = shadow {
-            sink.lint(
-                Some(c),
-                Some(p),
-                Diagnostic::lint(
-                    Lint::ShadowedRow,
-                    format!(
-                        "row {} of plan `{}` never fires: an earlier row always matches first",
-                        later.display_name(),
-                        verb(c, p)
-                    ),
-                    later.cond_span,
-                    "whenever this row would match",
-                )
-                .with_secondary(e.span, "this earlier row matches first")
+        let states: Vec<StateId> = (0..p.states.len())
+            .map(|s| StateId(s as u32))
+            .filter(|s| a.reachable[s.index()] && crate::analysis::covers(&later.from, *s))
+            .collect();
+        if states.is_empty()
+            || !states
+                .iter()
+                .all(|s| conditions.can_fire_in(j, *s).is_never())
+        {
+            continue;
+        }
+        // The earlier rows that take this row's cases: each can fire on a
+        // cycle where this row's condition holds.
+        let covering: Vec<&Row> = p.rows[..j]
+            .iter()
+            .filter(|e| !a.never_matches[e.position as usize])
+            .filter(|e| {
+                states.iter().any(|s| {
+                    !conditions
+                        .can_fire_while(e.position as usize, j, *s)
+                        .is_never()
+                })
+            })
+            .collect();
+        let mut d = Diagnostic::lint(
+            Lint::ShadowedRow,
+            format!(
+                "row {} of plan `{}` never fires: earlier rows always match first",
+                later.display_name(),
+                verb(c, p)
+            ),
+            later.cond_span,
+            "whenever this row would match",
+        );
+        for e in &covering {
+            d = d.with_secondary(e.span, format!("row {} matches first", e.display_name()));
+        }
+        let rows: Vec<String> = covering.iter().map(|e| e.display_name()).collect();
+        let how = match rows.as_slice() {
+            [one] => format!("row {one} matches whenever this row does"),
+            many => format!(
+                "together, rows {} match whenever this row does",
+                many.join(", ")
+            ),
+        };
+        sink.lint(
+            Some(c),
+            Some(p),
+            d.with_note(how)
                 .with_note(
                     "rows are tried in precedence order and only the first match fires (§4.2.2)",
                 )
                 .with_help("reorder the rows or make this condition more specific"),
-            );
-        }
+        );
     }
 }
 

@@ -1,0 +1,327 @@
+//! Stage 3a: analysis of the conditions of each plan — which rows can match
+//! at all, which can fire in which state, and a concrete witness for every
+//! "can". Read-only over the IR, like the checks, which ask it questions
+//! and stay small.
+//!
+//! ## What is decided, and how
+//!
+//! A row fires in state `s` when its own condition holds and the condition
+//! of no earlier row covering `s` does (`otherwise` aside, which fires when
+//! none holds). Each question is a satisfiability question over one cycle's
+//! inputs, the *leaves* ([`terms`]): `new_command`, the cycle counters,
+//! command parameters, vars and buffer fields, hook results (one value per
+//! distinct call per cycle, as the backends evaluate them) and the
+//! subordinates' statuses (one variable each, so `X.done`, `X.error` and
+//! `X.status == S` are mutually exclusive and exhaust X's statuses,
+//! `NOT_READY` and custom ones included).
+//!
+//! The technique is *cells plus search*. Every constant a leaf is compared
+//! with cuts the leaf's range (within its type's bounds; floats also keep
+//! ±∞ and NaN apart, so `x < 1.0` and `x >= 1.0` do not cover NaN), so
+//! that each comparison has one truth value per cell ([`domain`]). A
+//! depth-first search over one representative per cell, evaluating the
+//! formula three-valued after each choice ([`search`]), is then exhaustive:
+//! finding no assignment proves a row can never match or fire. Atoms the
+//! procedure does not model exactly (arithmetic on inputs, two inputs
+//! compared, a hook result compared with a variable) are *opaque*: for a
+//! proof they are free booleans — an over-approximation, so a proof stays a
+//! proof — and a witness must evaluate them on concrete values. A
+//! satisfying assignment found that way is checked by evaluating every atom
+//! with the language's one arithmetic ([`crate::arith`]), so a witness is
+//! what the interpreter would compute; when no concrete witness is found
+//! the answer is "unknown" and no check reports anything. No false alarm,
+//! by construction.
+//!
+//! Why not BDDs or an SMT solver: plans are small (the rule of ten), so the
+//! search stays in the hundreds of nodes; cells make integer ranges, enum
+//! and status exhaustion and float NaN exact without a theory solver; and
+//! the whole procedure is a few hundred lines with no native dependency for
+//! users to install. A node budget ([`search::BUDGET`]) bounds the worst
+//! case: past it, the answer is "unknown".
+
+pub mod domain;
+pub mod eval;
+pub mod search;
+pub mod terms;
+
+use crate::ir::{Condition, Controller, From, Ir, Plan, StateId, Type};
+use rcs_runtime::driver::Value;
+use search::{Mode, Outcome, Search};
+use terms::{Formula, Leaf, LeafId, Terms};
+
+/// The answer to "can this happen?".
+#[derive(Clone, Debug)]
+pub enum Answer {
+    /// Proved impossible.
+    Never,
+    /// Possible, with the inputs that make it happen.
+    Can(Witness),
+    /// Neither proved nor shown: say nothing.
+    Unknown,
+}
+
+impl Answer {
+    pub fn is_never(&self) -> bool {
+        matches!(self, Answer::Never)
+    }
+}
+
+/// One cycle's inputs that make something happen, in the state it happens in.
+#[derive(Clone, Debug)]
+pub struct Witness {
+    pub state: StateId,
+    /// Each input the question reads, with its value.
+    pub inputs: Vec<(Leaf, Value)>,
+    /// The same, as the language writes them: `cmd.n = 5`, `TB.status = DONE`.
+    pub shown: Vec<(String, String)>,
+}
+
+impl Witness {
+    /// `cmd.n = 5, x = 7.0, TB.status = DONE`.
+    pub fn text(&self) -> String {
+        self.shown
+            .iter()
+            .map(|(n, v)| format!("{n} = {v}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// The conditions of one plan, ready for questions.
+pub struct PlanAnalysis<'ir> {
+    ir: &'ir Ir,
+    ctrl: &'ir Controller,
+    plan: &'ir Plan,
+    terms: Terms,
+    /// Per row: its condition (`None` for `otherwise`).
+    conds: Vec<Option<Formula>>,
+    /// Per row: a representative value of every cell of every leaf.
+    cells: Vec<Vec<Value>>,
+    candidates: Vec<Vec<Value>>,
+    new_command: LeafId,
+}
+
+impl<'ir> PlanAnalysis<'ir> {
+    pub fn new(ir: &'ir Ir, ctrl: &'ir Controller, plan: &'ir Plan) -> PlanAnalysis<'ir> {
+        let mut terms = Terms::default();
+        let u32_ty = Type::Int(crate::ir::IntTy::U32);
+        let new_command = terms.intern(Leaf::NewCommand, Type::Bool);
+        terms.intern(Leaf::StateCycles, u32_ty.clone());
+        terms.intern(Leaf::PlanCycles, u32_ty);
+        let conds = plan
+            .rows
+            .iter()
+            .map(|r| match &r.cond {
+                Condition::When(e) => Some(terms.formula(e)),
+                Condition::Otherwise => None,
+            })
+            .collect();
+        let cells = domain::cells(ir, &terms);
+        let candidates = domain::candidates(ir, &terms, &cells);
+        PlanAnalysis {
+            ir,
+            ctrl,
+            plan,
+            terms,
+            conds,
+            cells,
+            candidates,
+            new_command,
+        }
+    }
+
+    /// Whether row `row` can match at all, judged by its own `from` and
+    /// condition (a new command resets the plan to `S0`, so `new_command`
+    /// is false in any other state).
+    pub fn can_match(&self, row: usize) -> Answer {
+        let r = &self.plan.rows[row];
+        let state = match r.from {
+            From::State(s) => s,
+            From::DontCare(_) => StateId::S0,
+        };
+        let f = self.conds[row].clone().unwrap_or(Formula::Const(true));
+        let fixed = match r.from {
+            From::State(s) if s != StateId::S0 => vec![(self.new_command, Value::Bool(false))],
+            _ => Vec::new(),
+        };
+        self.decide(&f, &fixed, state)
+    }
+
+    /// Whether row `row` can fire while the plan is in `state`: its state
+    /// pattern covers `state`, its condition holds, and no earlier row that
+    /// covers `state` matches (for `otherwise`: no other row matches).
+    pub fn can_fire_in(&self, row: usize, state: StateId) -> Answer {
+        match self.fires(row, state) {
+            Some(f) => self.decide(&f, &self.fixed(state), state),
+            None => Answer::Never,
+        }
+    }
+
+    /// Whether row `row` can fire in `state` on a cycle where row `other`'s
+    /// condition holds too: whether `row` takes some of `other`'s cases.
+    pub fn can_fire_while(&self, row: usize, other: usize, state: StateId) -> Answer {
+        let Some(fires) = self.fires(row, state) else {
+            return Answer::Never;
+        };
+        let also = self.conds[other].clone().unwrap_or(Formula::Const(true));
+        let f = Formula::And(vec![fires, also]);
+        self.decide(&f, &self.fixed(state), state)
+    }
+
+    /// The formula of "row `row` fires in `state`", `None` when its state
+    /// pattern does not cover `state`.
+    fn fires(&self, row: usize, state: StateId) -> Option<Formula> {
+        if !covers(&self.plan.rows[row].from, state) {
+            return None;
+        }
+        let mut parts = Vec::new();
+        let earlier: Vec<usize> = match &self.conds[row] {
+            Some(c) => {
+                parts.push(c.clone());
+                (0..row).collect()
+            }
+            None => (0..self.plan.rows.len()).filter(|i| *i != row).collect(),
+        };
+        for i in earlier {
+            if let (Some(c), true) = (&self.conds[i], covers(&self.plan.rows[i].from, state)) {
+                parts.push(Formula::Not(Box::new(c.clone())));
+            }
+        }
+        Some(Formula::And(parts))
+    }
+
+    /// What is known of a cycle in `state`: outside `S0`, no new command.
+    fn fixed(&self, state: StateId) -> Vec<(LeafId, Value)> {
+        if state == StateId::S0 {
+            Vec::new()
+        } else {
+            vec![(self.new_command, Value::Bool(false))]
+        }
+    }
+
+    fn decide(&self, f: &Formula, fixed: &[(LeafId, Value)], state: StateId) -> Answer {
+        match Search::new(&self.terms, Mode::Prove, &self.cells, fixed).run(f) {
+            Outcome::None => return Answer::Never,
+            Outcome::Unknown => return Answer::Unknown,
+            Outcome::Found(_) => {}
+        }
+        match Search::new(&self.terms, Mode::Witness, &self.candidates, fixed).run(f) {
+            Outcome::Found(values) => Answer::Can(self.witness(f, state, values)),
+            Outcome::None | Outcome::Unknown => Answer::Unknown,
+        }
+    }
+
+    /// The witness of an assignment: every input in `inputs`, and those the
+    /// question reads (and `new_command`, which says which cycle) shown.
+    fn witness(&self, f: &Formula, state: StateId, values: Vec<Option<Value>>) -> Witness {
+        let mut read = vec![false; self.terms.leaves.len()];
+        read[self.new_command] = true;
+        f.visit_atoms(&mut |a| {
+            for &l in &self.terms.atoms[a].leaves {
+                read[l] = true;
+            }
+        });
+        let mut inputs = Vec::new();
+        let mut shown = Vec::new();
+        for (i, v) in values.into_iter().enumerate() {
+            let Some(v) = v else { continue };
+            let (leaf, ty) = &self.terms.leaves[i];
+            if read[i] {
+                shown.push((self.leaf_name(leaf), self.value_text(ty, &v)));
+            }
+            inputs.push((leaf.clone(), v));
+        }
+        Witness {
+            state,
+            inputs,
+            shown,
+        }
+    }
+
+    /// A leaf as the language writes it.
+    pub fn leaf_name(&self, leaf: &Leaf) -> String {
+        use crate::ir::{Expr, ExprKind, SubProp};
+        let printer = crate::pretty::Printer::new(self.ir, self.ctrl, Some(self.plan));
+        let sub = |c: crate::ir::CtrlId| self.ir.controller(c).name.clone();
+        match leaf {
+            Leaf::NewCommand => "new_command".into(),
+            Leaf::StateCycles => "state_cycles".into(),
+            Leaf::PlanCycles => "plan_cycles".into(),
+            Leaf::SubStatus(c) => format!("{}.status", sub(*c)),
+            Leaf::SubStale(c) => format!("{}.{}", sub(*c), SubProp::StaleCycles.name()),
+            Leaf::Call(h, args) => printer.expr(&Expr {
+                kind: ExprKind::Call(*h, args.clone()),
+                ty: self.ctrl.hooks[h.index()].ret.clone(),
+                span: self.plan.span,
+            }),
+            Leaf::Param(p, steps) => {
+                let param = &self.ctrl.commands[self.plan.verb.index()].params[p.index()];
+                self.path(format!("cmd.{}", param.name), &param.ty, steps)
+            }
+            Leaf::Var(v, steps) => {
+                let var = &self.ctrl.vars[v.index()];
+                self.path(var.name.clone(), &var.ty, steps)
+            }
+            Leaf::Buffer(b, steps) => {
+                let buf = &self.ir.buffers[b.index()];
+                let fields = &self.ir.buffer_types[buf.ty.index()].fields;
+                // The first step is a field of the buffer's type.
+                match steps.split_first() {
+                    Some((terms::Step::Field(f), rest)) => {
+                        let field = &fields[*f as usize];
+                        self.path(format!("{}.{}", buf.name, field.name), &field.ty, rest)
+                    }
+                    _ => buf.name.clone(),
+                }
+            }
+        }
+    }
+
+    fn path(&self, mut name: String, mut ty: &'ir Type, steps: &[terms::Step]) -> String {
+        for s in steps {
+            match (s, ty) {
+                (terms::Step::Field(f), Type::Buffer(b)) => {
+                    let field = &self.ir.buffer_types[b.index()].fields[*f as usize];
+                    name.push('.');
+                    name.push_str(&field.name);
+                    ty = &field.ty;
+                }
+                (terms::Step::Index(i), Type::Array(e, _)) => {
+                    name.push_str(&format!("[{i}]"));
+                    ty = e;
+                }
+                _ => {}
+            }
+        }
+        name
+    }
+
+    /// A value as the language writes it.
+    pub fn value_text(&self, ty: &Type, v: &Value) -> String {
+        match (ty, v) {
+            (_, Value::Bool(b)) => b.to_string(),
+            (_, Value::Int(i)) => i.to_string(),
+            (_, Value::Float(f)) if f.is_nan() => "NaN".into(),
+            (_, Value::Float(f)) if f.is_infinite() => if *f > 0.0 { "inf" } else { "-inf" }.into(),
+            (_, Value::Float(f)) => crate::pretty::float(*f),
+            (Type::Enum(e), Value::Enum(i)) => {
+                let def = &self.ir.enums[e.index()];
+                let variant = def
+                    .variants
+                    .get(*i as usize)
+                    .map_or("?", |v| v.name.as_str());
+                format!("{}::{variant}", def.name)
+            }
+            (Type::Status(c), Value::Status(s)) => domain::status_name(self.ir, *c, *s),
+            (_, v) => format!("{v:?}"),
+        }
+    }
+}
+
+/// Whether a row's state pattern covers `state`.
+pub fn covers(from: &From, state: StateId) -> bool {
+    match from {
+        From::DontCare(_) => true,
+        From::State(s) => *s == state,
+    }
+}

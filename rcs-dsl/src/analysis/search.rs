@@ -1,0 +1,254 @@
+//! The decision procedure: a depth-first search over leaf values (and, when
+//! proving, opaque atoms as free booleans), evaluating the formula in
+//! three-valued logic after every choice and backtracking as soon as it is
+//! false. Exhaustive over the cells, so "no assignment" is a proof; bounded
+//! by a node budget, past which the answer is "unknown".
+
+use super::eval::eval;
+use super::terms::{Formula, Leaf, LeafId, Terms};
+use rcs_runtime::driver::Value;
+
+/// How many search nodes one question may take before it is undecided.
+pub const BUDGET: u64 = 200_000;
+
+/// What the search is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// Over cells, opaque atoms free: an empty answer proves the formula
+    /// unsatisfiable.
+    Prove,
+    /// Over concrete candidate values, every atom evaluated: an answer is a
+    /// real assignment (consistent counters included), but finding none
+    /// proves nothing.
+    Witness,
+}
+
+pub enum Outcome {
+    /// No assignment satisfies the formula (a proof only in `Prove` mode).
+    None,
+    /// An assignment: a value per leaf (`None`: any value will do).
+    Found(Vec<Option<Value>>),
+    /// The budget ran out.
+    Unknown,
+}
+
+pub struct Search<'a> {
+    terms: &'a Terms,
+    mode: Mode,
+    /// Per leaf, the values to try.
+    domains: &'a [Vec<Value>],
+    leaves: Vec<Option<Value>>,
+    opaque: Vec<Option<bool>>,
+    /// Search variables in order: leaves, then opaque atoms (`Prove`).
+    order: Vec<Var>,
+    nodes: u64,
+    new_command: Option<LeafId>,
+    state_cycles: Option<LeafId>,
+    plan_cycles: Option<LeafId>,
+}
+
+#[derive(Clone, Copy)]
+enum Var {
+    Leaf(LeafId),
+    Atom(usize),
+}
+
+impl<'a> Search<'a> {
+    /// A search over `domains` (cells or candidates, per leaf) with the
+    /// leaves in `fixed` already set.
+    pub fn new(
+        terms: &'a Terms,
+        mode: Mode,
+        domains: &'a [Vec<Value>],
+        fixed: &[(LeafId, Value)],
+    ) -> Search<'a> {
+        let mut leaves = vec![None; terms.leaves.len()];
+        for (l, v) in fixed {
+            leaves[*l] = Some(v.clone());
+        }
+        let find = |l: Leaf| terms.find(&l);
+        Search {
+            terms,
+            mode,
+            domains,
+            leaves,
+            opaque: vec![None; terms.atoms.len()],
+            order: Vec::new(),
+            nodes: 0,
+            new_command: find(Leaf::NewCommand),
+            state_cycles: find(Leaf::StateCycles),
+            plan_cycles: find(Leaf::PlanCycles),
+        }
+    }
+
+    pub fn run(mut self, f: &Formula) -> Outcome {
+        // Only what the formula reads is searched over.
+        let mut atoms = Vec::new();
+        collect_atoms(f, &mut atoms);
+        let mut leaves: Vec<LeafId> = Vec::new();
+        for &a in &atoms {
+            let atom = &self.terms.atoms[a];
+            if self.mode == Mode::Prove && !atom.exact {
+                self.order.push(Var::Atom(a));
+                continue;
+            }
+            for &l in &atom.leaves {
+                if !leaves.contains(&l) && self.leaves[l].is_none() {
+                    leaves.push(l);
+                }
+            }
+        }
+        if self.mode == Mode::Witness {
+            // The counters are related to each other and to `new_command`.
+            for l in [self.new_command, self.state_cycles, self.plan_cycles]
+                .into_iter()
+                .flatten()
+            {
+                if !leaves.contains(&l) && self.leaves[l].is_none() {
+                    leaves.push(l);
+                }
+            }
+        }
+        let mut order: Vec<Var> = leaves.into_iter().map(Var::Leaf).collect();
+        order.append(&mut self.order);
+        self.order = order;
+        match self.dfs(f, 0) {
+            Ok(true) => Outcome::Found(self.leaves),
+            Ok(false) => Outcome::None,
+            Err(()) => Outcome::Unknown,
+        }
+    }
+
+    fn dfs(&mut self, f: &Formula, depth: usize) -> Result<bool, ()> {
+        self.nodes += 1;
+        if self.nodes > BUDGET {
+            return Err(());
+        }
+        let verdict = and3(self.value(f), self.consistent());
+        match verdict {
+            Some(v) => return Ok(v),
+            None if depth == self.order.len() => return Ok(false),
+            None => {}
+        }
+        match self.order[depth] {
+            Var::Leaf(l) => {
+                for v in self.domains[l].iter() {
+                    self.leaves[l] = Some(v.clone());
+                    if self.dfs(f, depth + 1)? {
+                        return Ok(true);
+                    }
+                }
+                self.leaves[l] = None;
+            }
+            Var::Atom(a) => {
+                for b in [true, false] {
+                    self.opaque[a] = Some(b);
+                    if self.dfs(f, depth + 1)? {
+                        return Ok(true);
+                    }
+                }
+                self.opaque[a] = None;
+            }
+        }
+        Ok(false)
+    }
+
+    /// The formula's value under the current partial assignment.
+    fn value(&self, f: &Formula) -> Option<bool> {
+        match f {
+            Formula::Const(b) => Some(*b),
+            Formula::Atom(a) => self.atom(*a),
+            Formula::Not(x) => self.value(x).map(|b| !b),
+            Formula::And(xs) => {
+                let mut all = Some(true);
+                for x in xs {
+                    match self.value(x) {
+                        Some(false) => return Some(false),
+                        None => all = None,
+                        Some(true) => {}
+                    }
+                }
+                all
+            }
+            Formula::Or(xs) => {
+                let mut any = Some(false);
+                for x in xs {
+                    match self.value(x) {
+                        Some(true) => return Some(true),
+                        None => any = None,
+                        Some(false) => {}
+                    }
+                }
+                any
+            }
+        }
+    }
+
+    fn atom(&self, a: usize) -> Option<bool> {
+        let atom = &self.terms.atoms[a];
+        if self.mode == Mode::Prove && !atom.exact {
+            return self.opaque[a];
+        }
+        let lookup = |l: &Leaf| self.leaves[self.terms.find(l)?].clone();
+        match eval(&atom.expr, &lookup)? {
+            Value::Bool(b) => Some(b),
+            _ => None,
+        }
+    }
+
+    /// Whether the counters agree with each other and with `new_command`
+    /// (witnesses only): on a new command's cycle both are 0; on any later
+    /// cycle both are at least 1 and `plan_cycles >= state_cycles`.
+    fn consistent(&self) -> Option<bool> {
+        if self.mode == Mode::Prove {
+            return Some(true);
+        }
+        let get = |l: Option<LeafId>| l.map(|i| self.leaves[i].clone());
+        let int = |v: Option<Option<Value>>| match v {
+            Some(Some(Value::Int(i))) => Some(Some(i)),
+            Some(None) => Some(None),
+            None => None,
+            Some(Some(_)) => Some(None),
+        };
+        let nc = match get(self.new_command) {
+            Some(Some(Value::Bool(b))) => Some(b),
+            Some(_) => return None,
+            None => None,
+        };
+        // `None` (outer): the leaf does not exist; `Some(None)`: unassigned.
+        let sc = int(get(self.state_cycles));
+        let pc = int(get(self.plan_cycles));
+        if matches!(sc, Some(None)) || matches!(pc, Some(None)) {
+            return None;
+        }
+        let (sc, pc) = (sc.flatten(), pc.flatten());
+        let ok = match nc {
+            Some(true) => sc.unwrap_or(0) == 0 && pc.unwrap_or(0) == 0,
+            _ => {
+                sc.is_none_or(|s| s >= 1)
+                    && pc.is_none_or(|p| p >= 1)
+                    && match (sc, pc) {
+                        (Some(s), Some(p)) => p >= s,
+                        _ => true,
+                    }
+            }
+        };
+        Some(ok)
+    }
+}
+
+fn and3(a: Option<bool>, b: Option<bool>) -> Option<bool> {
+    match (a, b) {
+        (Some(false), _) | (_, Some(false)) => Some(false),
+        (Some(true), Some(true)) => Some(true),
+        _ => None,
+    }
+}
+
+fn collect_atoms(f: &Formula, out: &mut Vec<usize>) {
+    f.visit_atoms(&mut |a| {
+        if !out.contains(&a) {
+            out.push(a);
+        }
+    });
+}

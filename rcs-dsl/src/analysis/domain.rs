@@ -33,6 +33,36 @@ pub fn cells(ir: &Ir, terms: &Terms) -> Vec<Vec<Value>> {
         .collect()
 }
 
+/// Per atom: for an exact one, its truth value on each cell of its leaf
+/// (one entry for an atom that reads no leaf), so that a proof looks it up
+/// instead of evaluating.
+pub fn tables(terms: &Terms, cells: &[Vec<Value>]) -> Vec<Option<Vec<bool>>> {
+    terms
+        .atoms
+        .iter()
+        .map(|atom| {
+            if !atom.exact {
+                return None;
+            }
+            let truth = |v: Option<Value>| matches!(v, Some(Value::Bool(true)));
+            match atom.leaves.as_slice() {
+                [] => Some(vec![truth(eval(&atom.expr, &|_| None))]),
+                [leaf] => Some(
+                    cells[*leaf]
+                        .iter()
+                        .map(|cell| {
+                            let value =
+                                |l: &Leaf| (terms.find(l) == Some(*leaf)).then(|| cell.clone());
+                            truth(eval(&atom.expr, &value))
+                        })
+                        .collect(),
+                ),
+                _ => None,
+            }
+        })
+        .collect()
+}
+
 /// Per leaf, the values a witness search tries: its cells' representatives,
 /// then the extra candidates, without repeats.
 pub fn candidates(ir: &Ir, terms: &Terms, cells: &[Vec<Value>]) -> Vec<Vec<Value>> {

@@ -47,6 +47,7 @@ pub mod terms;
 use crate::ir::{Condition, Controller, From, Ir, Plan, StateId, Type};
 use rcs_runtime::driver::Value;
 use search::{Mode, Outcome, Search};
+use std::rc::Rc;
 use terms::{Formula, Leaf, LeafId, Terms};
 
 /// The answer to "can this happen?".
@@ -94,11 +95,24 @@ pub struct PlanAnalysis<'ir> {
     plan: &'ir Plan,
     terms: Terms,
     /// Per row: its condition (`None` for `otherwise`).
-    conds: Vec<Option<Formula>>,
+    conds: Vec<Option<Rc<Formula>>>,
     /// Per row: a representative value of every cell of every leaf.
     cells: Vec<Vec<Value>>,
-    candidates: Vec<Vec<Value>>,
+    /// Per atom: for an exact one, its truth value on each cell of its leaf.
+    tables: Vec<Option<Vec<bool>>>,
+    /// Per leaf, the values a witness search tries (made on first use).
+    candidates: std::cell::OnceCell<Vec<Vec<Value>>>,
     new_command: LeafId,
+    /// Proofs asked before, by question: the checks ask some twice.
+    proved: std::cell::RefCell<std::collections::BTreeMap<Question, bool>>,
+}
+
+/// A question whose proof is remembered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Question {
+    Matches(usize),
+    FiresIn(usize, StateId),
+    FiresWhile(usize, usize, StateId),
 }
 
 impl<'ir> PlanAnalysis<'ir> {
@@ -112,12 +126,12 @@ impl<'ir> PlanAnalysis<'ir> {
             .rows
             .iter()
             .map(|r| match &r.cond {
-                Condition::When(e) => Some(terms.formula(e)),
+                Condition::When(e) => Some(Rc::new(terms.formula(e))),
                 Condition::Otherwise => None,
             })
             .collect();
         let cells = domain::cells(ir, &terms);
-        let candidates = domain::candidates(ir, &terms, &cells);
+        let tables = domain::tables(&terms, &cells);
         PlanAnalysis {
             ir,
             ctrl,
@@ -125,8 +139,10 @@ impl<'ir> PlanAnalysis<'ir> {
             terms,
             conds,
             cells,
-            candidates,
+            tables,
+            candidates: std::cell::OnceCell::new(),
             new_command,
+            proved: Default::default(),
         }
     }
 
@@ -134,16 +150,7 @@ impl<'ir> PlanAnalysis<'ir> {
     /// condition (a new command resets the plan to `S0`, so `new_command`
     /// is false in any other state).
     pub fn can_match(&self, row: usize) -> Answer {
-        let r = &self.plan.rows[row];
-        let state = match r.from {
-            From::State(s) => s,
-            From::DontCare(_) => StateId::S0,
-        };
-        let f = self.conds[row].clone().unwrap_or(Formula::Const(true));
-        let fixed = match r.from {
-            From::State(s) if s != StateId::S0 => vec![(self.new_command, Value::Bool(false))],
-            _ => Vec::new(),
-        };
+        let (f, fixed, state) = self.question(Question::Matches(row));
         self.decide(&f, &fixed, state)
     }
 
@@ -151,21 +158,74 @@ impl<'ir> PlanAnalysis<'ir> {
     /// pattern covers `state`, its condition holds, and no earlier row that
     /// covers `state` matches (for `otherwise`: no other row matches).
     pub fn can_fire_in(&self, row: usize, state: StateId) -> Answer {
-        match self.fires(row, state) {
-            Some(f) => self.decide(&f, &self.fixed(state), state),
-            None => Answer::Never,
-        }
+        let (f, fixed, state) = self.question(Question::FiresIn(row, state));
+        self.decide(&f, &fixed, state)
     }
 
     /// Whether row `row` can fire in `state` on a cycle where row `other`'s
     /// condition holds too: whether `row` takes some of `other`'s cases.
     pub fn can_fire_while(&self, row: usize, other: usize, state: StateId) -> Answer {
-        let Some(fires) = self.fires(row, state) else {
-            return Answer::Never;
+        let (f, fixed, state) = self.question(Question::FiresWhile(row, other, state));
+        self.decide(&f, &fixed, state)
+    }
+
+    /// [`can_match`](Self::can_match) is [`Answer::Never`], without looking
+    /// for a witness otherwise (what the checks need, and much cheaper).
+    pub fn never_matches(&self, row: usize) -> bool {
+        self.proves_never(Question::Matches(row))
+    }
+
+    /// [`can_fire_in`](Self::can_fire_in) is [`Answer::Never`].
+    pub fn never_fires_in(&self, row: usize, state: StateId) -> bool {
+        self.proves_never(Question::FiresIn(row, state))
+    }
+
+    /// [`can_fire_while`](Self::can_fire_while) is [`Answer::Never`].
+    pub fn never_fires_while(&self, row: usize, other: usize, state: StateId) -> bool {
+        self.proves_never(Question::FiresWhile(row, other, state))
+    }
+
+    fn proves_never(&self, q: Question) -> bool {
+        if let Question::FiresIn(row, state) | Question::FiresWhile(row, _, state) = q {
+            if !covers(&self.plan.rows[row].from, state) {
+                return true;
+            }
+        }
+        if let Some(&never) = self.proved.borrow().get(&q) {
+            return never;
+        }
+        let (f, fixed, _) = self.question(q);
+        let never = matches!(self.prove(&f, &fixed), Outcome::None);
+        self.proved.borrow_mut().insert(q, never);
+        never
+    }
+
+    /// A question as a formula, the leaves it fixes, and its state.
+    fn question(&self, q: Question) -> (Formula, Vec<(LeafId, Value)>, StateId) {
+        let cond = |i: usize| match &self.conds[i] {
+            Some(c) => Formula::Shared(c.clone()),
+            None => Formula::Const(true),
         };
-        let also = self.conds[other].clone().unwrap_or(Formula::Const(true));
-        let f = Formula::And(vec![fires, also]);
-        self.decide(&f, &self.fixed(state), state)
+        match q {
+            Question::Matches(row) => {
+                let state = match self.plan.rows[row].from {
+                    From::State(s) => s,
+                    From::DontCare(_) => StateId::S0,
+                };
+                (cond(row), self.fixed(state), state)
+            }
+            Question::FiresIn(row, state) => {
+                let f = self.fires(row, state).unwrap_or(Formula::Const(false));
+                (f, self.fixed(state), state)
+            }
+            Question::FiresWhile(row, other, state) => {
+                let f = match self.fires(row, state) {
+                    Some(fires) => Formula::And(vec![fires, cond(other)]),
+                    None => Formula::Const(false),
+                };
+                (f, self.fixed(state), state)
+            }
+        }
     }
 
     /// The formula of "row `row` fires in `state`", `None` when its state
@@ -177,14 +237,14 @@ impl<'ir> PlanAnalysis<'ir> {
         let mut parts = Vec::new();
         let earlier: Vec<usize> = match &self.conds[row] {
             Some(c) => {
-                parts.push(c.clone());
+                parts.push(Formula::Shared(c.clone()));
                 (0..row).collect()
             }
             None => (0..self.plan.rows.len()).filter(|i| *i != row).collect(),
         };
         for i in earlier {
             if let (Some(c), true) = (&self.conds[i], covers(&self.plan.rows[i].from, state)) {
-                parts.push(Formula::Not(Box::new(c.clone())));
+                parts.push(Formula::Not(Box::new(Formula::Shared(c.clone()))));
             }
         }
         Some(Formula::And(parts))
@@ -199,13 +259,21 @@ impl<'ir> PlanAnalysis<'ir> {
         }
     }
 
+    fn prove(&self, f: &Formula, fixed: &[(LeafId, Value)]) -> Outcome {
+        Search::new(&self.terms, Mode::Prove, &self.cells, &self.tables, fixed).run(f)
+    }
+
     fn decide(&self, f: &Formula, fixed: &[(LeafId, Value)], state: StateId) -> Answer {
-        match Search::new(&self.terms, Mode::Prove, &self.cells, fixed).run(f) {
+        match self.prove(f, fixed) {
             Outcome::None => return Answer::Never,
             Outcome::Unknown => return Answer::Unknown,
             Outcome::Found(_) => {}
         }
-        match Search::new(&self.terms, Mode::Witness, &self.candidates, fixed).run(f) {
+        let candidates = self
+            .candidates
+            .get_or_init(|| domain::candidates(self.ir, &self.terms, &self.cells));
+        let search = Search::new(&self.terms, Mode::Witness, candidates, &[], fixed);
+        match search.run(f) {
             Outcome::Found(values) => Answer::Can(self.witness(f, state, values)),
             Outcome::None | Outcome::Unknown => Answer::Unknown,
         }

@@ -35,6 +35,11 @@ pub enum Outcome {
 pub struct Search<'a> {
     terms: &'a Terms,
     mode: Mode,
+    /// `Prove` only: per exact atom, its truth value on each cell of its
+    /// leaf (one leaf; constant atoms have one entry).
+    tables: &'a [Option<Vec<bool>>],
+    /// `Prove` only: the cell index each assigned leaf is in.
+    cell: Vec<usize>,
     /// Per leaf, the values to try.
     domains: &'a [Vec<Value>],
     leaves: Vec<Option<Value>>,
@@ -60,16 +65,22 @@ impl<'a> Search<'a> {
         terms: &'a Terms,
         mode: Mode,
         domains: &'a [Vec<Value>],
+        tables: &'a [Option<Vec<bool>>],
         fixed: &[(LeafId, Value)],
     ) -> Search<'a> {
         let mut leaves = vec![None; terms.leaves.len()];
+        let mut cell = vec![0; terms.leaves.len()];
         for (l, v) in fixed {
             leaves[*l] = Some(v.clone());
+            // A fixed value stands for its cell (fixed leaves are booleans).
+            cell[*l] = domains[*l].iter().position(|d| d == v).unwrap_or(0);
         }
         let find = |l: Leaf| terms.find(&l);
         Search {
             terms,
             mode,
+            tables,
+            cell,
             domains,
             leaves,
             opaque: vec![None; terms.atoms.len()],
@@ -132,8 +143,9 @@ impl<'a> Search<'a> {
         }
         match self.order[depth] {
             Var::Leaf(l) => {
-                for v in self.domains[l].iter() {
+                for (i, v) in self.domains[l].iter().enumerate() {
                     self.leaves[l] = Some(v.clone());
+                    self.cell[l] = i;
                     if self.dfs(f, depth + 1)? {
                         return Ok(true);
                     }
@@ -159,6 +171,7 @@ impl<'a> Search<'a> {
             Formula::Const(b) => Some(*b),
             Formula::Atom(a) => self.atom(*a),
             Formula::Not(x) => self.value(x).map(|b| !b),
+            Formula::Shared(x) => self.value(x),
             Formula::And(xs) => {
                 let mut all = Some(true);
                 for x in xs {
@@ -186,8 +199,20 @@ impl<'a> Search<'a> {
 
     fn atom(&self, a: usize) -> Option<bool> {
         let atom = &self.terms.atoms[a];
-        if self.mode == Mode::Prove && !atom.exact {
-            return self.opaque[a];
+        if self.mode == Mode::Prove {
+            if !atom.exact {
+                return self.opaque[a];
+            }
+            // Exact: a table lookup on the cell of its one leaf.
+            let table = self.tables[a].as_ref()?;
+            return match atom.leaves.as_slice() {
+                [] => table.first().copied(),
+                [l] => {
+                    self.leaves[*l].as_ref()?;
+                    table.get(self.cell[*l]).copied()
+                }
+                _ => None,
+            };
         }
         let lookup = |l: &Leaf| self.leaves[self.terms.find(l)?].clone();
         match eval(&atom.expr, &lookup)? {

@@ -50,6 +50,8 @@ pub enum Formula {
     Not(Box<Formula>),
     And(Vec<Formula>),
     Or(Vec<Formula>),
+    /// A formula shared between questions (a row's condition), not copied.
+    Shared(std::rc::Rc<Formula>),
 }
 
 impl Formula {
@@ -60,6 +62,7 @@ impl Formula {
             Formula::Atom(a) => f(*a),
             Formula::Not(x) => x.visit_atoms(f),
             Formula::And(xs) | Formula::Or(xs) => xs.iter().for_each(|x| x.visit_atoms(f)),
+            Formula::Shared(x) => x.visit_atoms(f),
         }
     }
 }

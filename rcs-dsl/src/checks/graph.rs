@@ -35,7 +35,7 @@ pub(crate) fn analyse(p: &Plan, conditions: &PlanAnalysis) -> Analysis {
     }
     let (done, error) = (NodeIndex::new(n), NodeIndex::new(n + 1));
     let never_matches: Vec<bool> = (0..p.rows.len())
-        .map(|i| conditions.can_match(i).is_never())
+        .map(|i| conditions.never_matches(i))
         .collect();
     for (i, (row, never)) in p.rows.iter().zip(&never_matches).enumerate() {
         if *never {
@@ -52,7 +52,7 @@ pub(crate) fn analyse(p: &Plan, conditions: &PlanAnalysis) -> Analysis {
         // outside S0) adds none.
         for f in 0..n {
             let state = StateId(f as u32);
-            if NodeIndex::new(f) != to && !conditions.can_fire_in(i, state).is_never() {
+            if NodeIndex::new(f) != to && !conditions.never_fires_in(i, state) {
                 g.add_edge(NodeIndex::new(f), to, ());
             }
         }

@@ -243,11 +243,7 @@ pub(crate) fn check_shadowed_rows(
             .map(|s| StateId(s as u32))
             .filter(|s| a.reachable[s.index()] && crate::analysis::covers(&later.from, *s))
             .collect();
-        if states.is_empty()
-            || !states
-                .iter()
-                .all(|s| conditions.can_fire_in(j, *s).is_never())
-        {
+        if states.is_empty() || !states.iter().all(|s| conditions.never_fires_in(j, *s)) {
             continue;
         }
         // The earlier rows that take this row's cases: each can fire on a
@@ -256,11 +252,9 @@ pub(crate) fn check_shadowed_rows(
             .iter()
             .filter(|e| !a.never_matches[e.position as usize])
             .filter(|e| {
-                states.iter().any(|s| {
-                    !conditions
-                        .can_fire_while(e.position as usize, j, *s)
-                        .is_never()
-                })
+                states
+                    .iter()
+                    .any(|s| !conditions.never_fires_while(e.position as usize, j, *s))
             })
             .collect();
         let mut d = Diagnostic::lint(

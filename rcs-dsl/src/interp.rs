@@ -185,6 +185,10 @@ pub struct Interpreter<'ir> {
     reads: Vec<Value>,
     writes: Vec<Value>,
     subs: Vec<SubState>,
+    /// While conditions are evaluated: the hook calls made so far this
+    /// cycle, by hook and syntactic arguments, with their results (each
+    /// distinct call runs at most once per cycle; jobs' calls are not kept).
+    condition_calls: Option<Vec<(HookId, Vec<Expr>, Value)>>,
 }
 
 impl<'ir> Interpreter<'ir> {
@@ -217,6 +221,7 @@ impl<'ir> Interpreter<'ir> {
                     view: SubordinateView::default(),
                 })
                 .collect(),
+            condition_calls: None,
         };
         let mut no_hooks = NoHooks;
         me.vars = c
@@ -331,6 +336,7 @@ impl<'ir> Interpreter<'ir> {
         };
         let state = StateId(self.bk.state() as u32);
         let mut chosen = None;
+        self.condition_calls = Some(Vec::new());
         for r in plan.rows.iter().filter(|r| !r.is_otherwise()) {
             let from_ok = match r.from {
                 From::DontCare(_) => true,
@@ -346,6 +352,7 @@ impl<'ir> Interpreter<'ir> {
                 }
             }
         }
+        self.condition_calls = None;
         let Some(row) = chosen.or_else(|| plan.otherwise()) else {
             return;
         };
@@ -480,7 +487,16 @@ impl<'ir> Interpreter<'ir> {
                 other => other,
             },
             ExprKind::Call(h, args) => {
-                let args: Vec<Value> = args.iter().map(|a| self.eval(a, hooks)).collect();
+                let cached = self.condition_calls.as_ref().and_then(|calls| {
+                    calls
+                        .iter()
+                        .find(|(ch, ca, _)| ch == h && ca == args)
+                        .map(|(_, _, v)| v.clone())
+                });
+                if let Some(v) = cached {
+                    return v;
+                }
+                let values: Vec<Value> = args.iter().map(|a| self.eval(a, hooks)).collect();
                 let data = HookData {
                     ctrl: self.ctrl,
                     params: &self.active_params,
@@ -488,7 +504,11 @@ impl<'ir> Interpreter<'ir> {
                     vars: &self.vars,
                     writes: &self.writes,
                 };
-                hooks.call(&data, *h, &args)
+                let v = hooks.call(&data, *h, &values);
+                if let Some(calls) = &mut self.condition_calls {
+                    calls.push((*h, args.clone(), v.clone()));
+                }
+                v
             }
             ExprKind::Sub(c, prop) => {
                 let i = self.ctrl.subordinate_index(*c).expect("a subordinate");

@@ -459,6 +459,10 @@ pub enum Projection {
 
 /// A typed expression. `ty` is always concrete (literals take the type their
 /// context fixes; unconstrained integer literals are `i64`, floats `f64`).
+///
+/// Equality is syntactic: the same kind and type, wherever it is written
+/// (spans are ignored). Both backends cache a condition's hook call by its
+/// hook and its arguments compared this way.
 #[derive(Clone, Debug, Serialize)]
 pub struct Expr {
     pub kind: ExprKind,
@@ -466,7 +470,13 @@ pub struct Expr {
     pub span: Span,
 }
 
-#[derive(Clone, Debug, Serialize)]
+impl PartialEq for Expr {
+    fn eq(&self, other: &Expr) -> bool {
+        self.kind == other.kind && self.ty == other.ty
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ExprKind {
     Int(i128),

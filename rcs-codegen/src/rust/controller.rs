@@ -3,7 +3,7 @@
 //! and `Controller`, whose `cycle` is SEMANTICS.md's six steps with the
 //! rows compiled to a dispatch on the state.
 
-use super::expr::{rust_type, zero, Code, Gen};
+use super::expr::{rust_type, zero, CachedCall, Code, Gen};
 use super::names::Names;
 use super::Comments;
 use crate::ident::prefixed;
@@ -58,12 +58,18 @@ pub(crate) fn module(
     let n = &names.ctrls[ci];
     let name = &c.name;
     let module = &n.module;
-    let mod_docs = docs(&c.docs);
-    let title = c
-        .title
-        .as_ref()
-        .map(|t| format!(" `{name}`: {t}."))
-        .unwrap_or_else(|| format!(" Controller `{name}`."));
+    // The controller's doc comment, which usually names it already; the
+    // title line only stands in for a missing one.
+    let mod_docs = if c.docs.is_empty() {
+        let title = c
+            .title
+            .as_ref()
+            .map(|t| format!(" `{name}`: {t}."))
+            .unwrap_or_else(|| format!(" Controller `{name}`."));
+        quote!(#[doc = #title])
+    } else {
+        docs(&c.docs)
+    };
 
     // ---- commands
     let verb_count = c.commands.len();
@@ -193,6 +199,26 @@ pub(crate) fn module(
         }
     });
 
+    // ---- verb and state names
+    let verb_ids: Vec<u16> = (0..c.commands.len() as u16).collect();
+    let verb_names: Vec<&str> = c.commands.iter().map(|k| k.name.as_str()).collect();
+    let state_arms = c.commands.iter().enumerate().filter_map(|(i, k)| {
+        let pid = k.plan?;
+        let ty = &n.plans[pid.index()].state_ty;
+        let i = i as u16;
+        Some(quote!(#i => match #ty::from_raw(state) { Some(s) => Some(s.name()), None => None }))
+    });
+    let names_fns = quote! {
+        /// The name of a verb of this controller's, as written in the plans.
+        pub const fn verb_name(verb: rt::VerbId) -> Option<&'static str> {
+            match verb { #(#verb_ids => Some(#verb_names),)* _ => None }
+        }
+        /// The name of a state of a verb's plan, as written in the plans.
+        pub const fn state_name(verb: rt::VerbId, state: rt::StateId) -> Option<&'static str> {
+            match verb { #(#state_arms,)* _ => None }
+        }
+    };
+
     // ---- hooks
     let hook_fns = c.hooks.iter().enumerate().map(|(hi, h)| {
         let id = &n.hooks[hi];
@@ -238,6 +264,7 @@ pub(crate) fn module(
         names,
         ctrl: c,
         ci,
+        cached: &[],
     };
     let var_defaults_derivable = c
         .vars
@@ -350,7 +377,6 @@ pub(crate) fn module(
 
     quote! {
         #mod_docs
-        #[doc = #title]
         pub mod #module {
             use ::rcs_runtime as rt;
 
@@ -358,6 +384,8 @@ pub(crate) fn module(
             pub const NAME: &str = #name;
 
             #command_enum
+
+            #names_fns
 
             #[doc = #status_doc]
             pub mod status {
@@ -497,13 +525,21 @@ pub(crate) fn module(
                 pub fn bookkeeping(&self) -> &rt::Bookkeeping { &self.bk }
                 /// The current status, typed.
                 pub fn status(&self) -> Option<Status> { Status::from_raw(self.bk.status()) }
+                /// The verb being executed, by name (`None` before the first command).
+                pub fn verb_name(&self) -> Option<&'static str> {
+                    if self.bk.echo_serial() == 0 { None } else { verb_name(self.bk.verb()) }
+                }
+                /// The state of the plan being executed, by name (`None` before the first command).
+                pub fn state_name(&self) -> Option<&'static str> {
+                    if self.bk.echo_serial() == 0 { None } else { state_name(self.bk.verb(), self.bk.state()) }
+                }
 
                 #decide
 
                 #(#plan_fns)*
             }
 
-            impl<H: Hooks> rt::Controller for Controller<H> {
+            impl<H: Hooks + 'static> rt::Controller for Controller<H> {
                 fn name(&self) -> &str { NAME }
 
                 fn cycle(&mut self, ctx: &rt::CycleContext) {
@@ -661,7 +697,27 @@ fn plan_fn(
         names,
         ctrl: c,
         ci,
+        cached: &[],
     };
+    // Each distinct hook call of the conditions runs at most once per
+    // cycle, on first use: its result waits in a local for the next row.
+    let cached = CachedCall::collect(
+        names,
+        ci,
+        p.rows.iter().filter_map(|r| match &r.cond {
+            Condition::When(e) => Some(e),
+            Condition::Otherwise => None,
+        }),
+    );
+    let cond_gen = Gen {
+        cached: &cached,
+        ..gen
+    };
+    let cache_locals = cached.iter().map(|k| {
+        let local = &k.local;
+        let ty = rust_type(names, &c.hooks[k.hook.index()].ret);
+        quote!(let mut #local: Option<#ty> = None;)
+    });
     let printer = Printer::new(ir, c, Some(p));
     let subs_param = if uses_subs(p) {
         quote!(subs: Subs,)
@@ -703,7 +759,7 @@ fn plan_fn(
             self.bk.fire(#pos, #target);
         };
         let cond = match &r.cond {
-            Condition::When(e) => Some(gen.expr(e)),
+            Condition::When(e) => Some(cond_gen.expr(e)),
             Condition::Otherwise => None,
         };
         (cond, body)
@@ -797,24 +853,8 @@ fn plan_fn(
     let doc = format!(" Plan `{}` ({} rows).", cmd.name, p.rows.len());
     quote! {
         #[doc = #doc]
-        // Conditions are the plan's own, verbatim: redundant or duplicated
-        // logic in a plan is the plan's (rcsc's checks report what matters,
-        // e.g. `shadowed_row`) and must not fail the user's clippy run.
-        #[allow(
-            unused_comparisons,
-            clippy::nonminimal_bool,
-            clippy::overly_complex_bool_expr,
-            clippy::eq_op,
-            clippy::redundant_comparisons,
-            clippy::double_comparisons,
-            clippy::ifs_same_cond,
-            clippy::identity_op,
-            clippy::erasing_op,
-            clippy::absurd_extreme_comparisons,
-            clippy::manual_range_contains,
-            clippy::approx_constant
-        )]
         fn #func(&mut self, #subs_param #(#args),*) {
+            #(#cache_locals)*
             #body
         }
     }

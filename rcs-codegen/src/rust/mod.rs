@@ -90,6 +90,23 @@ pub fn system_module(ir: &Ir, options: &crate::Options) -> String {
     let tokens = quote! {
         #[doc = #doc]
         pub mod #system_ident {
+            // Conditions are the plan's own, verbatim: redundant or duplicated
+            // logic in a plan is the plan's (rcsc's checks report what matters,
+            // e.g. `shadowed_row`) and must not fail the user's clippy run.
+            #![allow(
+                unused_comparisons,
+                clippy::nonminimal_bool,
+                clippy::overly_complex_bool_expr,
+                clippy::eq_op,
+                clippy::redundant_comparisons,
+                clippy::double_comparisons,
+                clippy::ifs_same_cond,
+                clippy::identity_op,
+                clippy::erasing_op,
+                clippy::absurd_extreme_comparisons,
+                clippy::manual_range_contains,
+                clippy::approx_constant
+            )]
             use ::rcs_runtime as rt;
             #types
             #(#controllers)*

@@ -255,6 +255,8 @@ pub struct Controller {
     pub subordinate_spans: Vec<Span>,
     /// The span of each `subordinates` list as written.
     pub subordinates_lists: Vec<Span>,
+    /// The doc comment of each `reads`/`writes` declaration that has one.
+    pub buffer_docs: Vec<(BufferId, Vec<String>)>,
     /// Where each `reads`/`writes` buffer is declared (its name), for diagnostics.
     #[serde(skip)]
     pub buffer_spans: Vec<(BufferId, Span)>,
@@ -272,6 +274,7 @@ pub struct Command {
 #[derive(Clone, Debug, Serialize)]
 pub struct Param {
     pub name: String,
+    pub docs: Vec<String>,
     pub ty: Type,
     pub span: Span,
 }

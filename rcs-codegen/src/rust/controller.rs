@@ -18,6 +18,15 @@ fn docs(lines: &[String]) -> TokenStream {
     quote!(#(#[doc = #lines])*)
 }
 
+/// Doc lines as a paragraph after a first line: a blank line, then them.
+fn paragraph(lines: &[String]) -> TokenStream {
+    if lines.is_empty() {
+        return TokenStream::new();
+    }
+    let d = docs(lines);
+    quote!(#[doc = ""] #d)
+}
+
 /// Whether the leftmost conjunct of a condition is `new_command`: such a
 /// row can only match in S0, so other states' arms leave it out without
 /// skipping any hook call it would have made.
@@ -100,7 +109,8 @@ pub(crate) fn module(
             } else {
                 let ps = &n.params[i];
                 let tys = k.params.iter().map(|p| rust_type(names, &p.ty));
-                quote!(#d #default #v { #(#ps: #tys),* })
+                let pdocs = k.params.iter().map(|p| docs(&p.docs));
+                quote!(#d #default #v { #(#pdocs #ps: #tys),* })
             }
         });
         let arms = c.commands.iter().enumerate().map(|(i, k)| {
@@ -177,9 +187,10 @@ pub(crate) fn module(
         let vs = &pn.states;
         let ids: Vec<u16> = (0..p.states.len() as u16).collect();
         let doc = format!(" The states of plan `{}`.", c.commands[p.verb.index()].name);
+        let plan_docs = paragraph(&p.docs);
         let state_names: Vec<&str> = p.states.iter().map(|s| s.name.as_str()).collect();
         quote! {
-            #[doc = #doc]
+            #[doc = #doc] #plan_docs
             #[derive(Clone, Copy, Debug, PartialEq, Eq)]
             pub enum #ty { #(#vs),* }
             impl #ty {
@@ -224,7 +235,19 @@ pub(crate) fn module(
         let id = &n.hooks[hi];
         let ps = &n.hook_params[hi];
         let tys = h.params.iter().map(|p| rust_type(names, &p.ty));
-        let d = docs(&h.docs);
+        // Parameters cannot carry docs in Rust: theirs follow the hook's.
+        let mut lines = h.docs.clone();
+        let documented: Vec<&Param> = h.params.iter().filter(|p| !p.docs.is_empty()).collect();
+        if !documented.is_empty() {
+            if !lines.is_empty() {
+                lines.push(String::new());
+            }
+            lines.push("Parameters:".into());
+            for p in documented {
+                lines.push(format!("- `{}`: {}", p.name, p.docs.join(" ")));
+            }
+        }
+        let d = docs(&lines);
         if h.ret == Type::Unit {
             quote!(#d fn #id(&mut self, data: &Data #(, #ps: #tys)*);)
         } else {
@@ -255,6 +278,20 @@ pub(crate) fn module(
         sub_modules,
         sub_handles,
     } = Wiring::new(ir, names, ci);
+    // A `reads`/`writes` declaration's doc comment, else the buffer's name.
+    let buffer_docs = |list: &[BufferId]| -> Vec<TokenStream> {
+        list.iter()
+            .map(|b| match c.buffer_docs.iter().find(|(x, _)| x == b) {
+                Some((_, lines)) => docs(lines),
+                None => {
+                    let d = format!(" Global Memory buffer `{}`.", ir.buffers[b.index()].name);
+                    quote!(#[doc = #d])
+                }
+            })
+            .collect()
+    };
+    let read_docs = buffer_docs(&c.reads);
+    let write_docs = buffer_docs(&c.writes);
     let sub_fields = &n.subs;
     let var_fields = &n.vars;
     let var_tys: Vec<_> = c.vars.iter().map(|v| rust_type(names, &v.ty)).collect();
@@ -456,11 +493,11 @@ pub(crate) fn module(
 
             /// The Global Memory buffers this controller reads, as copied in this cycle.
             #[derive(Clone, Copy, Debug, Default, PartialEq)]
-            pub struct Reads { #(pub #read_fields: #read_tys),* }
+            pub struct Reads { #(#read_docs pub #read_fields: #read_tys),* }
 
             /// The Global Memory buffers this controller alone writes.
             #[derive(Clone, Copy, Debug, Default, PartialEq)]
-            pub struct Writes { #(pub #write_fields: #write_tys),* }
+            pub struct Writes { #(#write_docs pub #write_fields: #write_tys),* }
 
             /// The subordinates' statuses, seen through the handshake.
             #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -476,9 +513,13 @@ pub(crate) fn module(
             pub struct Data {
                 /// The command being executed.
                 pub command: Command,
+                /// The buffers read, copied in at the start of the cycle.
                 pub reads: Reads,
+                /// The subordinates' statuses this cycle.
                 pub subs: Subs,
+                /// The world-model variables.
                 pub vars: Vars,
+                /// The buffers written, copied out at the end of the cycle.
                 pub writes: Writes,
             }
 
@@ -737,6 +778,9 @@ fn plan_fn(
             printer.target(r),
             r.line
         );
+        // The row's doc comment, then the row as written.
+        let doc_markers: Vec<TokenStream> =
+            r.docs.iter().map(|l| comments.marker(l.clone())).collect();
         let marker = comments.marker(text);
         let jobs: Vec<TokenStream> = r.jobs.iter().map(|j| gen.job(j)).collect();
         let pos = r.position as u16;
@@ -754,6 +798,7 @@ fn plan_fn(
             }
         };
         let body = quote! {
+            #(#doc_markers)*
             #marker
             #(#jobs)*
             self.bk.fire(#pos, #target);
@@ -850,9 +895,11 @@ fn plan_fn(
             }
         }
     };
-    let doc = format!(" Plan `{}` ({} rows).", cmd.name, p.rows.len());
+    let rows_word = if p.rows.len() == 1 { "row" } else { "rows" };
+    let doc = format!(" Plan `{}` ({} {rows_word}).", cmd.name, p.rows.len());
+    let plan_docs = paragraph(&p.docs);
     quote! {
-        #[doc = #doc]
+        #[doc = #doc] #plan_docs
         fn #func(&mut self, #subs_param #(#args),*) {
             #(#cache_locals)*
             #body

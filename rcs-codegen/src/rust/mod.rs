@@ -41,8 +41,11 @@ impl Comments {
                 Some(n) => {
                     let indent = &line[..line.len() - trimmed.len()];
                     out.push_str(indent);
-                    out.push_str("// ");
-                    out.push_str(&self.texts[n]);
+                    out.push_str("//");
+                    if !self.texts[n].is_empty() {
+                        out.push(' ');
+                        out.push_str(&self.texts[n]);
+                    }
                 }
                 None => out.push_str(line),
             }
@@ -201,5 +204,48 @@ mod tests {
         assert!(on.contains("impl ::rcs_runtime::driver::Driven for Driver"));
         assert!(on.contains("pub fn new_driver("));
         assert!(on.contains("impl ::rcs_runtime::driver::FromValue for Big"));
+    }
+
+    #[test]
+    fn doc_comments_reach_the_rust_items_they_document() {
+        let set = rcs_dsl::PlanSet::from_texts(
+            "t",
+            [(
+                "t.rcs",
+                "buffer B { x: f64 }\n\
+                 /// Controller A.\n\
+                 controller A \"Title\" {\n\
+                 /// Read doc.\n    reads b: B\n\
+                 /// Write doc.\n    writes c: B\n\
+                 command GO(\n        /// Param doc.\n        speed: f64,\n    )\n\
+                 hook h(\n        /// Hook param doc.\n        n: f64,\n    )\n\
+                 /// Plan doc.\n    plan GO {\n\
+                 /// Row doc.\n        *0 when new_command -> Done { c.x = cmd.speed; h(b.x) }\n    }\n}\n",
+            )],
+            None,
+        );
+        let ir = rcs_dsl::check(&set, &rcs_dsl::Options::default())
+            .ir
+            .expect("clean");
+        let text = super::system_module(&ir, &crate::Options::default());
+        let lines: Vec<&str> = text.lines().map(str::trim).collect();
+        let before = |doc: &str, item: &str| {
+            assert!(
+                lines
+                    .windows(2)
+                    .any(|w| w[0] == doc && w[1].starts_with(item)),
+                "no `{doc}` right above `{item}` in\n{text}"
+            );
+        };
+        before("/// Read doc.", "pub b: super::types::B");
+        before("/// Write doc.", "pub c: super::types::B");
+        before("/// Param doc.", "speed: f64");
+        before("/// - `n`: Hook param doc.", "fn h(");
+        before("/// Plan doc.", "#[derive");
+        before("/// Plan doc.", "fn plan_go(");
+        before("// Row doc.", "// E0: *0 when new_command -> Done");
+        // The controller's doc comment stands for its title.
+        before("/// Controller A.", "pub mod a {");
+        assert!(!text.contains("`A`: Title."));
     }
 }

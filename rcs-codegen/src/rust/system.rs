@@ -24,6 +24,31 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
     let written: Vec<usize> = (0..ir.buffers.len())
         .filter(|b| ir.buffers[*b].writer.is_some())
         .collect();
+    // A buffer's docs: those of a `reads`/`writes` declaration of it, if
+    // any has some (its writer's first), else its name and type.
+    let buffer_doc = |b: usize| -> TokenStream {
+        let declared = ir.buffers[b]
+            .writer
+            .iter()
+            .chain(&ir.buffers[b].readers)
+            .find_map(|c| {
+                ir.controllers[c.index()]
+                    .buffer_docs
+                    .iter()
+                    .find(|(x, _)| x.index() == b)
+            });
+        let lines: Vec<String> = match declared {
+            Some((_, lines)) => lines.iter().map(|l| format!(" {l}")).collect(),
+            None => vec![format!(
+                " Buffer `{}` (`{}`).",
+                ir.buffers[b].name,
+                ir.buffer_types[ir.buffers[b].ty.index()].name
+            )],
+        };
+        quote!(#(#[doc = #lines])*)
+    };
+    let in_docs: Vec<TokenStream> = external.iter().map(|b| buffer_doc(*b)).collect();
+    let out_docs: Vec<TokenStream> = written.iter().map(|b| buffer_doc(*b)).collect();
     let in_fields: Vec<_> = external.iter().map(|b| &names.gm_buffers[*b]).collect();
     let in_tys: Vec<_> = external.iter().map(|b| ty_of(*b)).collect();
     let in_names: Vec<&str> = external
@@ -39,6 +64,15 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
 
     let roots: Vec<usize> = (0..ir.controllers.len())
         .filter(|c| ir.controllers[*c].supervisor.is_none())
+        .collect();
+    let root_docs: Vec<String> = roots
+        .iter()
+        .map(|c| {
+            format!(
+                " Commands `{}` and reads its status.",
+                ir.controllers[*c].name
+            )
+        })
         .collect();
     let root_fields: Vec<_> = roots.iter().map(|c| &names.ctrls[*c].module).collect();
     let root_names: Vec<&str> = roots
@@ -147,17 +181,17 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
         /// Global Memory buffers no controller writes: sensor drivers and
         /// simulators write them through these handles (one writer each).
         #[derive(Debug)]
-        pub struct Inputs { #(pub #in_fields: rt::Writer<#in_tys>),* }
+        pub struct Inputs { #(#in_docs pub #in_fields: rt::Writer<#in_tys>),* }
 
         /// Readers of the buffers the controllers write, for actuators,
         /// simulators and displays.
         #[derive(Clone, Debug)]
-        pub struct Outputs { #(pub #out_fields: rt::Reader<#out_tys>),* }
+        pub struct Outputs { #(#out_docs pub #out_fields: rt::Reader<#out_tys>),* }
 
         /// The operator's handle on each root controller (§3.7): the only
         /// way in, through the root's command buffer.
         #[derive(Debug)]
-        pub struct Operators { #(pub #root_fields: rt::Operator<#root_fields::Command>),* }
+        pub struct Operators { #(#[doc = #root_docs] pub #root_fields: rt::Operator<#root_fields::Command>),* }
 
         /// The hand-written hooks of each controller that has some, by the
         /// controller's name: what [`System::new`] builds the controllers with.

@@ -313,6 +313,26 @@ fn system_example(ir: &Ir, names: &Names) -> Vec<String> {
         ));
         lines.push("}".into());
     }
+    lines.extend(
+        [
+            "",
+            "// Timing: per executive, and per controller (nanoseconds).",
+            "let exec = &system.executives[0];",
+            "println!(\"{} cycles, {} overruns\", exec.stats().cycles, exec.overruns());",
+            "",
+            "// Real time: each executive on its own thread, on its heartbeat.",
+            "let mut running = Vec::new();",
+            "for exec in std::mem::take(&mut system.executives) {",
+            "    running.push(exec.spawn()?);",
+            "}",
+            "std::thread::sleep(std::time::Duration::from_secs(1)); // write inputs, read outputs",
+            "for (handle, join) in running {",
+            "    handle.stop();",
+            "    system.executives.push(join.join().expect(\"executive thread\"));",
+            "}",
+        ]
+        .map(String::from),
+    );
     lines.iter().map(|l| format!(" {l}")).collect()
 }
 

@@ -635,10 +635,13 @@ pub struct Driven<'ir> {
 struct Scripted<'ir> {
     ir: &'ir Ir,
     values: Vec<Option<Value>>,
+    /// Calls of each hook since the last cycle's record.
+    calls: Vec<u32>,
 }
 
 impl Hooks for Scripted<'_> {
     fn call(&mut self, data: &HookData, hook: HookId, _: &[Value]) -> Value {
+        self.calls[hook.index()] = self.calls[hook.index()].saturating_add(1);
         self.values[hook.index()]
             .clone()
             .unwrap_or_else(|| zero(self.ir, &data.ctrl.hooks[hook.index()].ret))
@@ -652,6 +655,7 @@ impl<'ir> Driven<'ir> {
         let hooks = Scripted {
             ir,
             values: vec![None; interp.controller().hooks.len()],
+            calls: vec![0; interp.controller().hooks.len()],
         };
         Driven { ir, interp, hooks }
     }
@@ -758,6 +762,8 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
 
     fn cycle(&mut self) -> rcs_runtime::driver::Record {
         let rec = self.interp.cycle(&mut self.hooks);
+        let hook_calls = self.hooks.calls.clone();
+        self.hooks.calls.fill(0);
         let c = self.interp.controller();
         rcs_runtime::driver::Record {
             cycle: rec.cycle,
@@ -778,6 +784,7 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
                 .collect(),
             vars: rec.vars,
             writes: rec.writes,
+            hook_calls,
         }
     }
 }

@@ -52,3 +52,39 @@ fn a_conditions_hook_call_runs_once_per_cycle_and_a_jobs_every_time() {
         );
     }
 }
+
+/// The scenario drivers of both backends count each hook's calls in the
+/// cycle's record (which the differential test compares): a condition's
+/// call once however many rows ask, a job's every time.
+#[test]
+fn both_backends_record_the_same_hook_call_counts() {
+    use rcs_runtime::driver::{Driven, Value};
+    let path = "tests/data/ok/0019_hook_calls_once_per_cycle.rcs";
+    let set = rcs_plan_sets::SETS
+        .iter()
+        .find(|s| s.path == path)
+        .expect("the set is compiled");
+    let mut generated = (set.new_driver)("C").expect("C").expect("setup");
+    let text = std::fs::read_to_string(format!("../../{path}")).expect("plan");
+    let plans = rcs_dsl::PlanSet::from_texts("calls", [("calls.rcs", text.as_str())], None);
+    let ir = rcs_dsl::check(&plans, &rcs_dsl::Options::default())
+        .ir
+        .expect("checks clean");
+    let c = ir.controller_by_name("C").expect("C");
+    let mut interp = rcs_dsl::interp::Driven::new(&ir, c);
+    for d in [&mut *generated as &mut dyn Driven, &mut interp] {
+        d.set_hook("depth", &Value::Int(5)).expect("depth");
+        d.command("WATCH", &[]).expect("WATCH");
+        assert_eq!(
+            d.cycle().hook_calls,
+            [0, 0, 0],
+            "{}: E0 asks none",
+            d.name()
+        );
+        for _ in 0..3 {
+            // depth: once for the conditions, twice in E3's jobs; over(2)
+            // once (over(1) is never reached); log twice.
+            assert_eq!(d.cycle().hook_calls, [3, 1, 2], "{}", d.name());
+        }
+    }
+}

@@ -248,4 +248,33 @@ mod tests {
         before("/// Controller A.", "pub mod a {");
         assert!(!text.contains("`A`: Title."));
     }
+
+    #[test]
+    fn the_hooks_and_system_types_do_not_depend_on_file_names() {
+        let zed = "controller Z {\n    command GO\n    hook z() -> bool\n    plan GO { *0 when new_command && z() -> Done }\n}\n";
+        let ant = "controller A {\n    command GO\n    hook a() -> bool\n    plan GO { *0 when new_command && a() -> Done }\n}\n";
+        let api = |files: [(&str, &str); 2]| -> Vec<String> {
+            let set = rcs_dsl::PlanSet::from_texts("t", files, None);
+            let ir = rcs_dsl::check(&set, &rcs_dsl::Options::default())
+                .ir
+                .expect("clean");
+            super::system_module(&ir, &crate::Options::default())
+                .lines()
+                .map(str::trim)
+                .filter(|l| {
+                    l.starts_with("pub struct Hooks")
+                        || l.starts_with("pub struct System")
+                        || l.starts_with("impl<")
+                })
+                .map(String::from)
+                .collect()
+        };
+        let one = api([("1.rcs", zed), ("2.rcs", ant)]);
+        let other = api([("2.rcs", ant), ("9.rcs", zed)]);
+        assert!(
+            one.contains(&"pub struct Hooks<AHooks, ZHooks> {".to_string()),
+            "{one:?}"
+        );
+        assert_eq!(one, other);
+    }
 }

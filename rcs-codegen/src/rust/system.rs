@@ -82,9 +82,7 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
 
     // One field of `Hooks`, and one type parameter, per controller that
     // has hooks: passed by name, so the order of files never matters.
-    let hooked: Vec<usize> = (0..ir.controllers.len())
-        .filter(|c| !ir.controllers[*c].hooks.is_empty())
-        .collect();
+    let hooked = hooked(ir);
     let hook_fields: Vec<&Ident> = hooked.iter().map(|c| &names.ctrls[*c].module).collect();
     let hook_generics: Vec<Ident> = hooked
         .iter()
@@ -262,9 +260,7 @@ fn system_example(ir: &Ir, names: &Names) -> Vec<String> {
     let mut lines = vec![format!("rcs_runtime::include_plans!({:?});", ir.system)];
     lines.push(format!("use {system}::{{Hooks, System}};"));
     lines.push(String::new());
-    let hooked: Vec<usize> = (0..ir.controllers.len())
-        .filter(|c| !ir.controllers[*c].hooks.is_empty())
-        .collect();
+    let hooked = hooked(ir);
     if hooked.is_empty() {
         lines.push("let mut system = System::new(Hooks {})?;".into());
     } else {
@@ -345,4 +341,15 @@ fn accessor(module: &Ident) -> String {
     } else {
         base
     }
+}
+
+/// The controllers with hooks, by name: the fields and type parameters of
+/// `Hooks` and `System` in this order, so that renaming or reordering the
+/// plan set's files never changes them.
+fn hooked(ir: &Ir) -> Vec<usize> {
+    let mut hooked: Vec<usize> = (0..ir.controllers.len())
+        .filter(|c| !ir.controllers[*c].hooks.is_empty())
+        .collect();
+    hooked.sort_by(|a, b| ir.controllers[*a].name.cmp(&ir.controllers[*b].name));
+    hooked
 }

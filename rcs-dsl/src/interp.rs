@@ -445,7 +445,9 @@ impl<'ir> Interpreter<'ir> {
     }
 
     /// Evaluate an expression of this controller (left to right, `&&` and
-    /// `||` short-circuit, so hook calls happen in a defined order).
+    /// `||` short-circuit, so hook calls happen in a defined order). While a
+    /// cycle's conditions are tried, a hook call already made with the same
+    /// arguments gives its earlier result instead of calling again.
     pub fn eval(&mut self, e: &Expr, hooks: &mut dyn Hooks) -> Value {
         match &e.kind {
             ExprKind::Int(v) => Value::Int(*v),

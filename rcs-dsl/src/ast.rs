@@ -118,6 +118,8 @@ pub enum EntryKind {
 
 #[derive(Clone, Debug)]
 pub struct Param {
+    /// `///` lines before the parameter.
+    pub docs: Vec<String>,
     pub name: Name,
     pub ty: TypeExpr,
 }

@@ -144,6 +144,10 @@ pub struct Interpreter<'ir> {
     reads: Vec<Value>,
     writes: Vec<Value>,
     subs: Vec<SubState>,
+    /// While conditions are evaluated: the hook calls made so far this
+    /// cycle, by hook and syntactic arguments, with their results (each
+    /// distinct call runs at most once per cycle; jobs' calls are not kept).
+    condition_calls: Option<Vec<(HookId, Vec<Expr>, Value)>>,
 }
 
 impl<'ir> Interpreter<'ir> {
@@ -176,6 +180,7 @@ impl<'ir> Interpreter<'ir> {
                     view: SubordinateView::default(),
                 })
                 .collect(),
+            condition_calls: None,
         };
         let mut no_hooks = NoHooks;
         me.vars = c
@@ -290,6 +295,7 @@ impl<'ir> Interpreter<'ir> {
         };
         let state = StateId(self.bk.state() as u32);
         let mut chosen = None;
+        self.condition_calls = Some(Vec::new());
         for r in plan.rows.iter().filter(|r| !r.is_otherwise()) {
             let from_ok = match r.from {
                 From::DontCare(_) => true,
@@ -305,6 +311,7 @@ impl<'ir> Interpreter<'ir> {
                 }
             }
         }
+        self.condition_calls = None;
         let Some(row) = chosen.or_else(|| plan.otherwise()) else {
             return;
         };
@@ -397,7 +404,9 @@ impl<'ir> Interpreter<'ir> {
     }
 
     /// Evaluate an expression of this controller (left to right, `&&` and
-    /// `||` short-circuit, so hook calls happen in a defined order).
+    /// `||` short-circuit, so hook calls happen in a defined order). While a
+    /// cycle's conditions are tried, a hook call already made with the same
+    /// arguments gives its earlier result instead of calling again.
     pub fn eval(&mut self, e: &Expr, hooks: &mut dyn Hooks) -> Value {
         match &e.kind {
             ExprKind::Int(v) => Value::Int(*v),
@@ -436,7 +445,16 @@ impl<'ir> Interpreter<'ir> {
                 other => other,
             },
             ExprKind::Call(h, args) => {
-                let args: Vec<Value> = args.iter().map(|a| self.eval(a, hooks)).collect();
+                let cached = self.condition_calls.as_ref().and_then(|calls| {
+                    calls
+                        .iter()
+                        .find(|(ch, ca, _)| ch == h && ca == args)
+                        .map(|(_, _, v)| v.clone())
+                });
+                if let Some(v) = cached {
+                    return v;
+                }
+                let values: Vec<Value> = args.iter().map(|a| self.eval(a, hooks)).collect();
                 let data = HookData {
                     ctrl: self.ctrl,
                     params: &self.active_params,
@@ -444,7 +462,11 @@ impl<'ir> Interpreter<'ir> {
                     vars: &self.vars,
                     writes: &self.writes,
                 };
-                hooks.call(&data, *h, &args)
+                let v = hooks.call(&data, *h, &values);
+                if let Some(calls) = &mut self.condition_calls {
+                    calls.push((*h, args.clone(), v.clone()));
+                }
+                v
             }
             ExprKind::Sub(c, prop) => {
                 let i = self.ctrl.subordinate_index(*c).expect("a subordinate");
@@ -507,10 +529,13 @@ pub struct Driven<'ir> {
 struct Scripted<'ir> {
     ir: &'ir Ir,
     values: Vec<Option<Value>>,
+    /// Calls of each hook since the last cycle's record.
+    calls: Vec<u32>,
 }
 
 impl Hooks for Scripted<'_> {
     fn call(&mut self, data: &HookData, hook: HookId, _: &[Value]) -> Value {
+        self.calls[hook.index()] = self.calls[hook.index()].saturating_add(1);
         self.values[hook.index()]
             .clone()
             .unwrap_or_else(|| zero(self.ir, &data.ctrl.hooks[hook.index()].ret))
@@ -524,6 +549,7 @@ impl<'ir> Driven<'ir> {
         let hooks = Scripted {
             ir,
             values: vec![None; interp.controller().hooks.len()],
+            calls: vec![0; interp.controller().hooks.len()],
         };
         Driven { ir, interp, hooks }
     }
@@ -630,6 +656,8 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
 
     fn cycle(&mut self) -> rcs_runtime::driver::Record {
         let rec = self.interp.cycle(&mut self.hooks);
+        let hook_calls = self.hooks.calls.clone();
+        self.hooks.calls.fill(0);
         let c = self.interp.controller();
         rcs_runtime::driver::Record {
             cycle: rec.cycle,
@@ -650,6 +678,7 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
                 .collect(),
             vars: rec.vars,
             writes: rec.writes,
+            hook_calls,
         }
     }
 }

@@ -255,6 +255,8 @@ pub struct Controller {
     pub subordinate_spans: Vec<Span>,
     /// The span of each `subordinates` list as written.
     pub subordinates_lists: Vec<Span>,
+    /// The doc comment of each `reads`/`writes` declaration that has one.
+    pub buffer_docs: Vec<(BufferId, Vec<String>)>,
     /// Where each `reads`/`writes` buffer is declared (its name), for diagnostics.
     #[serde(skip)]
     pub buffer_spans: Vec<(BufferId, Span)>,
@@ -272,6 +274,7 @@ pub struct Command {
 #[derive(Clone, Debug, Serialize)]
 pub struct Param {
     pub name: String,
+    pub docs: Vec<String>,
     pub ty: Type,
     pub span: Span,
 }
@@ -459,6 +462,10 @@ pub enum Projection {
 
 /// A typed expression. `ty` is always concrete (literals take the type their
 /// context fixes; unconstrained integer literals are `i64`, floats `f64`).
+///
+/// Equality is syntactic: the same kind and type, wherever it is written
+/// (spans are ignored). Both backends cache a condition's hook call by its
+/// hook and its arguments compared this way.
 #[derive(Clone, Debug, Serialize)]
 pub struct Expr {
     pub kind: ExprKind,
@@ -466,7 +473,13 @@ pub struct Expr {
     pub span: Span,
 }
 
-#[derive(Clone, Debug, Serialize)]
+impl PartialEq for Expr {
+    fn eq(&self, other: &Expr) -> bool {
+        self.kind == other.kind && self.ty == other.ty
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ExprKind {
     Int(i128),

@@ -587,10 +587,9 @@ impl Builder {
         pairs
             .filter(|p| p.as_rule() == Rule::param)
             .map(|p| {
-                let mut inner = p.into_inner();
-                let name = self.name(inner.next().expect("param name"));
-                let ty = self.type_expr(inner.next().expect("param type"));
-                Param { name, ty }
+                // A parameter is written like a buffer field: docs, name, type.
+                let Field { docs, name, ty } = self.field(p);
+                Param { docs, name, ty }
             })
             .collect()
     }

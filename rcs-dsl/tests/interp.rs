@@ -97,3 +97,55 @@ fn figure13_fault_from_any_state_ends_in_error() {
         ("*0", "S1", u32::from(rcs_runtime::Status::EXECUTING.0))
     );
 }
+
+const HOOK_CALLS: &str = include_str!("../../tests/data/ok/0019_hook_calls_once_per_cycle.rcs");
+
+/// Hooks that log every call: `depth` returns 5 and `over` false.
+#[derive(Default)]
+struct Counting {
+    calls: Vec<String>,
+}
+
+impl Hooks for Counting {
+    fn call(&mut self, data: &HookData, hook: HookId, args: &[Value]) -> Value {
+        let name = &data.ctrl.hooks[hook.index()].name;
+        let args: Vec<String> = args
+            .iter()
+            .map(|a| match a {
+                Value::Int(i) => i.to_string(),
+                other => format!("{other:?}"),
+            })
+            .collect();
+        self.calls.push(format!("{name}({})", args.join(", ")));
+        match name.as_str() {
+            "depth" => Value::Int(5),
+            "over" => Value::Bool(false),
+            _ => Value::Unit,
+        }
+    }
+}
+
+#[test]
+fn a_conditions_hook_call_runs_once_per_cycle_and_a_jobs_every_time() {
+    let set = PlanSet::from_texts("calls", [("calls.rcs", HOOK_CALLS)], None);
+    let ir = check(&set, &Options::default()).ir.expect("checks clean");
+    let c = ir.controller_by_name("C").unwrap();
+    let mut interp = Interpreter::new(&ir, c);
+    interp.command(CommandId(0), vec![]);
+    let mut hooks = Counting::default();
+    interp.cycle(&mut hooks); // E0: new command → S1, no hook asked
+    assert_eq!(hooks.calls, Vec::<String>::new());
+    for cycle in 1..4 {
+        let rec = interp.cycle(&mut hooks);
+        assert_eq!(rec.fired.map(|r| r.index()), Some(3), "cycle {cycle}");
+        // E1 asks depth() (false, so over(1) is never reached); E2 asks
+        // over(2) and depth() again (cached); E3 asks both (cached). The
+        // jobs call depth() and log() every time they are written.
+        assert_eq!(
+            hooks.calls,
+            ["depth()", "over(2)", "depth()", "log(5)", "depth()", "log(5)"],
+            "cycle {cycle}"
+        );
+        hooks.calls.clear();
+    }
+}

@@ -293,6 +293,10 @@ pub struct Record {
     pub vars: Vec<Value>,
     /// Its `writes` buffers after the cycle, in declaration order.
     pub writes: Vec<Value>,
+    /// How many times each hook was called this cycle, in declaration
+    /// order (a condition's call counts once however many rows ask).
+    #[serde(default)]
+    pub hook_calls: Vec<u32>,
 }
 
 /// One controller driven alone. Names are as written in the plans.

@@ -16,6 +16,7 @@
 //! Nothing here allocates or locks once the controllers are added, unless a
 //! trace sink is attached ([`Executive::set_trace`]).
 
+use std::any::Any;
 use std::io;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
@@ -50,7 +51,10 @@ impl CycleContext {
 
 /// A controller module (or simulator, or driver) that an executive runs once
 /// per cycle. A controller only talks to others through Global Memory.
-pub trait Controller: Send {
+///
+/// Controllers are `'static` ([`Any`]), so that whoever added one can get
+/// it back as its own type: [`Executive::controller_as`].
+pub trait Controller: Any + Send {
     /// The controller's name, for statistics and traces.
     fn name(&self) -> &str;
 
@@ -512,6 +516,19 @@ impl Executive {
             .find(|s| s.name == name)
             .map(|s| s.ctrl.as_ref())
     }
+    /// The controller called `name` as its own type `T`: `None` if there is
+    /// none or it is not a `T`. A lookup by name, not for the cycle path.
+    pub fn controller_as<T: Controller>(&self, name: &str) -> Option<&T> {
+        let any: &dyn Any = self.controller(name)?;
+        any.downcast_ref()
+    }
+    /// [`controller_as`](Self::controller_as), mutably (between cycles: to
+    /// adjust a controller's hand-written hooks, say).
+    pub fn controller_as_mut<T: Controller>(&mut self, name: &str) -> Option<&mut T> {
+        let slot = self.slots.iter_mut().find(|s| s.name == name)?;
+        let any: &mut dyn Any = slot.ctrl.as_mut();
+        any.downcast_mut()
+    }
 }
 
 #[cfg(test)]
@@ -557,5 +574,42 @@ mod tests {
             period: Duration::from_millis(1),
         };
         assert_eq!(ctx.tick(), Tick { cycle: 4, now });
+    }
+
+    struct Counter(u64);
+    impl Controller for Counter {
+        fn name(&self) -> &str {
+            "count"
+        }
+        fn cycle(&mut self, _: &CycleContext) {
+            self.0 += 1;
+        }
+    }
+    struct Other;
+    impl Controller for Other {
+        fn name(&self) -> &str {
+            "other"
+        }
+        fn cycle(&mut self, _: &CycleContext) {}
+    }
+
+    #[test]
+    fn a_controller_comes_back_as_its_own_type() -> Result<(), SetupError> {
+        let mut exec = Executive::new(ExecutiveConfig::new("x", Duration::from_millis(1)))?;
+        exec.add(Box::new(Counter(0)))?;
+        exec.add(Box::new(Other))?;
+        exec.run_cycles(3);
+        assert_eq!(exec.controller_as::<Counter>("count").map(|c| c.0), Some(3));
+        assert!(exec.controller_as::<Other>("count").is_none());
+        assert!(exec.controller_as::<Counter>("nobody").is_none());
+        if let Some(c) = exec.controller_as_mut::<Counter>("count") {
+            c.0 = 10;
+        }
+        exec.step();
+        assert_eq!(
+            exec.controller_as::<Counter>("count").map(|c| c.0),
+            Some(11)
+        );
+        Ok(())
     }
 }

@@ -17,12 +17,12 @@
 
 use std::process::ExitCode;
 
-use rcs_runtime::{Bookkeeping, RowId, Status};
+use rcs_runtime::RowId;
 
 rcs_runtime::include_plans!("figure13");
 
 use figure13::types::Events;
-use figure13::{gx, System};
+use figure13::{gx, Hooks, System};
 
 /// The rows of plan `RUN` by row id (precedence position), as written in
 /// `plans/figure13/figure13.rcs`.
@@ -89,36 +89,22 @@ fn row_text(row: RowId) -> &'static str {
 
 /// Where GX's plan is: its state, or `Done` / `Error(CODE)` once finished
 /// (`-` before the first command).
-fn place(bk: &Bookkeeping) -> String {
-    if bk.echo_serial() == 0 {
+fn place<H: gx::Hooks>(gx: &gx::Controller<H>) -> String {
+    let Some(state) = gx.state_name() else {
         return "-".into();
-    }
-    match gx::Status::from_raw(bk.status()) {
+    };
+    match gx.status() {
         Some(gx::Status::Done) => "Done".into(),
         Some(gx::Status::Error) => format!(
             "Error({})",
-            gx::Error::from_raw(bk.error()).map_or("?", gx::Error::name)
+            gx::Error::from_raw(gx.bookkeeping().error()).map_or("?", gx::Error::name)
         ),
-        _ => gx::RunState::from_raw(bk.state())
-            .map_or("?", gx::RunState::name)
-            .into(),
+        _ => state.into(),
     }
 }
 
-fn status_name(s: Status) -> &'static str {
-    gx::Status::from_raw(s).map_or("?", gx::Status::name)
-}
-
-fn gx_bookkeeping(system: &System) -> Option<&Bookkeeping> {
-    system
-        .executives
-        .first()?
-        .controller(gx::NAME)?
-        .bookkeeping()
-}
-
 fn main() -> ExitCode {
-    let mut system = match System::new() {
+    let mut system = match System::new(Hooks {}) {
         Ok(system) => system,
         Err(e) => {
             eprintln!("figure13: setup failed: {e}");
@@ -140,13 +126,13 @@ fn main() -> ExitCode {
     let mut fired: Vec<&'static str> = Vec::new();
     for (cycle, (event, note)) in SCRIPT.iter().enumerate() {
         system.inputs.ev.write(events(*event), cycle as u64);
-        let before = gx_bookkeeping(&system).map_or_else(|| "?".into(), place);
+        let before = system.gx().map_or_else(|| "?".into(), place);
         system.run_cycles(1);
-        let Some(bk) = gx_bookkeeping(&system) else {
+        let Some(gx) = system.gx() else {
             eprintln!("figure13: the executive has no GX");
             return ExitCode::from(2);
         };
-        let row = bk.fired();
+        let row = gx.bookkeeping().fired();
         if let Some(row) = row {
             fired.push(row_name(row));
         }
@@ -154,8 +140,8 @@ fn main() -> ExitCode {
             "{cycle:>5} | {:<5} | {:<36} | {:<13} | {:<9} | {note}",
             event.map_or_else(|| "-".to_string(), |e| format!("e{e}")),
             row.map_or("none", row_text),
-            format!("{before} -> {}", place(bk)),
-            status_name(bk.status()),
+            format!("{before} -> {}", place(gx)),
+            gx.status().map_or("?", gx::Status::name),
         );
     }
 

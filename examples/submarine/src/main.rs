@@ -26,15 +26,15 @@
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
-use rcs_runtime::{
-    Bookkeeping, Command as _, Executive, Heartbeat, RowId, SampleStats, StateId, Status, VerbId,
-    Wait,
-};
+use rcs_runtime::{Executive, Heartbeat, RowId, SampleStats, Wait};
 
 rcs_runtime::include_plans!("submarine");
 
 use submarine::types::{Ship, ShipDirection, SpeedError, TurbineDrive, TurbineSensors};
-use submarine::{pr, sm, tb, System};
+use submarine::{pr, sm, tb, Hooks, System};
+
+/// The submarine system with PR's hooks.
+type Sub = System<Propulsion>;
 
 /// Half-width of PR's dead band, in knots: inside it the ship is `At` speed.
 const DEAD_BAND_KN: f64 = 0.1;
@@ -155,84 +155,40 @@ impl Plant {
 }
 
 // ---------------------------------------------------------------------------
-// Display: names from the generated typed enums
-
-/// Verb and state names of a controller's bookkeeping.
-type Names = fn(VerbId, StateId) -> Option<(&'static str, &'static str)>;
-
-fn sm_names(verb: VerbId, state: StateId) -> Option<(&'static str, &'static str)> {
-    if verb == sm::Command::Init.verb() {
-        Some(("INIT", sm::InitState::from_raw(state)?.name()))
-    } else if verb == (sm::Command::Transit { speed: 0.0 }).verb() {
-        Some(("TRANSIT", sm::TransitState::from_raw(state)?.name()))
-    } else {
-        None
-    }
-}
-
-fn pr_names(verb: VerbId, state: StateId) -> Option<(&'static str, &'static str)> {
-    if verb == pr::Command::Init.verb() {
-        Some(("INIT", pr::InitState::from_raw(state)?.name()))
-    } else if verb == pr::Command::Halt.verb() {
-        Some(("HALT", pr::HaltState::from_raw(state)?.name()))
-    } else if verb == (pr::Command::Ahead { speed: 0.0 }).verb() {
-        Some(("AHEAD", pr::AheadState::from_raw(state)?.name()))
-    } else {
-        None
-    }
-}
-
-fn tb_names(verb: VerbId, state: StateId) -> Option<(&'static str, &'static str)> {
-    if verb == tb::Command::Init.verb() {
-        Some(("INIT", tb::InitState::from_raw(state)?.name()))
-    } else if verb == tb::Command::Halt.verb() {
-        Some(("HALT", tb::HaltState::from_raw(state)?.name()))
-    } else if verb == (tb::Command::Ahead { rpm: 0.0 }).verb() {
-        Some(("AHEAD", tb::AheadState::from_raw(state)?.name()))
-    } else if verb == tb::Command::Stop.verb() {
-        Some(("STOP", tb::StopState::from_raw(state)?.name()))
-    } else {
-        None
-    }
-}
-
-fn sm_status(s: Status) -> &'static str {
-    sm::Status::from_raw(s).map_or("?", sm::Status::name)
-}
-fn pr_status(s: Status) -> &'static str {
-    pr::Status::from_raw(s).map_or("?", pr::Status::name)
-}
-fn tb_status(s: Status) -> &'static str {
-    tb::Status::from_raw(s).map_or("?", tb::Status::name)
-}
+// Display: names from the generated typed controllers
 
 /// `VERB STATE STATUS` of one controller (`- - NOT_READY` before its first
-/// command).
-fn cell(bk: Option<&Bookkeeping>, names: Names, status: fn(Status) -> &'static str) -> String {
-    let Some(bk) = bk else {
-        return "?".into();
-    };
-    let (verb, state) = if bk.echo_serial() == 0 {
-        ("-", "-")
-    } else {
-        names(bk.verb(), bk.state()).unwrap_or(("?", "?"))
-    };
-    format!("{verb} {state} {}", status(bk.status()))
-}
-
-fn bookkeeping<'a>(exec: &'a Executive, name: &str) -> Option<&'a Bookkeeping> {
-    exec.controller(name).and_then(|c| c.bookkeeping())
+/// command; `?` for a controller the system lacks).
+fn cell(verb_state_status: Option<(Option<&str>, Option<&str>, &str)>) -> String {
+    match verb_state_status {
+        Some((verb, state, status)) => {
+            format!("{} {} {status}", verb.unwrap_or("-"), state.unwrap_or("-"))
+        }
+        None => "?".into(),
+    }
 }
 
 /// One table row: the controllers after this cycle, the rows PR fired since
 /// the last table row, and the world the controllers read in this cycle.
-fn print_row(cycle: u64, exec: &Executive, pr_rows: &[RowId], drive: TurbineDrive, read: Plant) {
+fn print_row(cycle: u64, system: &Sub, pr_rows: &[RowId], drive: TurbineDrive, read: Plant) {
     let rows = rows_fired(pr_rows);
+    let sm = system.sm().map(|c| {
+        let status = c.status().map_or("?", sm::Status::name);
+        (c.verb_name(), c.state_name(), status)
+    });
+    let pr = system.pr().map(|c| {
+        let status = c.status().map_or("?", pr::Status::name);
+        (c.verb_name(), c.state_name(), status)
+    });
+    let tb = system.tb().map(|c| {
+        let status = c.status().map_or("?", tb::Status::name);
+        (c.verb_name(), c.state_name(), status)
+    });
     println!(
         "{cycle:>5} | {:<20} | {:<18} | {rows:<7} | {:<18} | {:>7.1} | {:>8.1} | {:>7.3}",
-        cell(bookkeeping(exec, sm::NAME), sm_names, sm_status),
-        cell(bookkeeping(exec, pr::NAME), pr_names, pr_status),
-        cell(bookkeeping(exec, tb::NAME), tb_names, tb_status),
+        cell(sm),
+        cell(pr),
+        cell(tb),
         drive.rpm_setpoint,
         read.rpm,
         read.speed,
@@ -370,7 +326,7 @@ fn run(opts: Options) -> Result<bool, rcs_runtime::SetupError> {
         rpm_per_knot: MODEL_RPM_PER_KNOT,
         dead_band: DEAD_BAND_KN,
     };
-    let mut system = System::new(hooks)?;
+    let mut system = System::new(Hooks { pr: hooks })?;
     let Some(period) = system.executives.first().map(Executive::period) else {
         return Ok(false);
     };
@@ -422,19 +378,17 @@ fn run(opts: Options) -> Result<bool, rcs_runtime::SetupError> {
         system.inputs.ship.write(plant.ship(), cycle + 1);
         system.inputs.turbine.write(plant.turbine(), cycle + 1);
 
-        let exec = &system.executives[0];
-        let pr_bk = bookkeeping(exec, pr::NAME);
-        pr_rows.extend(pr_bk.and_then(Bookkeeping::fired));
-        let pr_now = pr_bk.map(Bookkeeping::status);
-        let sm_now = bookkeeping(exec, sm::NAME).map(Bookkeeping::status);
-        failed = sm_now == Some(sm::status::ERROR) || pr_now == Some(pr::status::ERROR);
-        let first_goal = goal_at.is_none() && pr_now == Some(pr::status::AT_GOAL);
+        pr_rows.extend(system.pr().and_then(|c| c.bookkeeping().fired()));
+        let pr_now = system.pr().and_then(pr::Controller::status);
+        let sm_now = system.sm().and_then(sm::Controller::status);
+        failed = sm_now == Some(sm::Status::Error) || pr_now == Some(pr::Status::Error);
+        let first_goal = goal_at.is_none() && pr_now == Some(pr::Status::AtGoal);
         if first_goal {
             goal_at = Some(cycle);
         }
         let last = failed || goal_at.is_some_and(|g| cycle >= g + opts.hold);
         if cycle.is_multiple_of(opts.every) || first_goal || last {
-            print_row(cycle, exec, &pr_rows, drive, read);
+            print_row(cycle, &system, &pr_rows, drive, read);
             pr_rows.clear();
         }
         if first_goal {
@@ -508,7 +462,10 @@ fn run(opts: Options) -> Result<bool, rcs_runtime::SetupError> {
         _ if failed => Ok(false),
         Some(_) => Ok(true),
         None => {
-            let pr_now = bookkeeping(exec, pr::NAME).map_or("?", |bk| pr_status(bk.status()));
+            let pr_now = system
+                .pr()
+                .and_then(pr::Controller::status)
+                .map_or("?", pr::Status::name);
             eprintln!(
                 "submarine: PR did not report AT_GOAL within {} cycles (PR is {pr_now})",
                 opts.max_cycles

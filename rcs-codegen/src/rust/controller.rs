@@ -3,7 +3,7 @@
 //! and `Controller`, whose `cycle` is SEMANTICS.md's six steps with the
 //! rows compiled to a dispatch on the state.
 
-use super::expr::{rust_type, zero, Code, Gen};
+use super::expr::{rust_type, zero, CachedCall, Code, Gen};
 use super::names::Names;
 use super::Comments;
 use crate::ident::prefixed;
@@ -16,6 +16,15 @@ use rcs_dsl::pretty::Printer;
 fn docs(lines: &[String]) -> TokenStream {
     let lines = lines.iter().map(|l| format!(" {l}"));
     quote!(#(#[doc = #lines])*)
+}
+
+/// Doc lines as a paragraph after a first line: a blank line, then them.
+fn paragraph(lines: &[String]) -> TokenStream {
+    if lines.is_empty() {
+        return TokenStream::new();
+    }
+    let d = docs(lines);
+    quote!(#[doc = ""] #d)
 }
 
 /// Whether the leftmost conjunct of a condition is `new_command`: such a
@@ -58,12 +67,18 @@ pub(crate) fn module(
     let n = &names.ctrls[ci];
     let name = &c.name;
     let module = &n.module;
-    let mod_docs = docs(&c.docs);
-    let title = c
-        .title
-        .as_ref()
-        .map(|t| format!(" `{name}`: {t}."))
-        .unwrap_or_else(|| format!(" Controller `{name}`."));
+    // The controller's doc comment, which usually names it already; the
+    // title line only stands in for a missing one.
+    let mod_docs = if c.docs.is_empty() {
+        let title = c
+            .title
+            .as_ref()
+            .map(|t| format!(" `{name}`: {t}."))
+            .unwrap_or_else(|| format!(" Controller `{name}`."));
+        quote!(#[doc = #title])
+    } else {
+        docs(&c.docs)
+    };
 
     // ---- commands
     let verb_count = c.commands.len();
@@ -94,7 +109,8 @@ pub(crate) fn module(
             } else {
                 let ps = &n.params[i];
                 let tys = k.params.iter().map(|p| rust_type(names, &p.ty));
-                quote!(#d #default #v { #(#ps: #tys),* })
+                let pdocs = k.params.iter().map(|p| docs(&p.docs));
+                quote!(#d #default #v { #(#pdocs #ps: #tys),* })
             }
         });
         let arms = c.commands.iter().enumerate().map(|(i, k)| {
@@ -171,9 +187,10 @@ pub(crate) fn module(
         let vs = &pn.states;
         let ids: Vec<u16> = (0..p.states.len() as u16).collect();
         let doc = format!(" The states of plan `{}`.", c.commands[p.verb.index()].name);
+        let plan_docs = paragraph(&p.docs);
         let state_names: Vec<&str> = p.states.iter().map(|s| s.name.as_str()).collect();
         quote! {
-            #[doc = #doc]
+            #[doc = #doc] #plan_docs
             #[derive(Clone, Copy, Debug, PartialEq, Eq)]
             pub enum #ty { #(#vs),* }
             impl #ty {
@@ -193,12 +210,44 @@ pub(crate) fn module(
         }
     });
 
+    // ---- verb and state names
+    let verb_ids: Vec<u16> = (0..c.commands.len() as u16).collect();
+    let verb_names: Vec<&str> = c.commands.iter().map(|k| k.name.as_str()).collect();
+    let state_arms = c.commands.iter().enumerate().filter_map(|(i, k)| {
+        let pid = k.plan?;
+        let ty = &n.plans[pid.index()].state_ty;
+        let i = i as u16;
+        Some(quote!(#i => match #ty::from_raw(state) { Some(s) => Some(s.name()), None => None }))
+    });
+    let names_fns = quote! {
+        /// The name of a verb of this controller's, as written in the plans.
+        pub const fn verb_name(verb: rt::VerbId) -> Option<&'static str> {
+            match verb { #(#verb_ids => Some(#verb_names),)* _ => None }
+        }
+        /// The name of a state of a verb's plan, as written in the plans.
+        pub const fn state_name(verb: rt::VerbId, state: rt::StateId) -> Option<&'static str> {
+            match verb { #(#state_arms,)* _ => None }
+        }
+    };
+
     // ---- hooks
     let hook_fns = c.hooks.iter().enumerate().map(|(hi, h)| {
         let id = &n.hooks[hi];
         let ps = &n.hook_params[hi];
         let tys = h.params.iter().map(|p| rust_type(names, &p.ty));
-        let d = docs(&h.docs);
+        // Parameters cannot carry docs in Rust: theirs follow the hook's.
+        let mut lines = h.docs.clone();
+        let documented: Vec<&Param> = h.params.iter().filter(|p| !p.docs.is_empty()).collect();
+        if !documented.is_empty() {
+            if !lines.is_empty() {
+                lines.push(String::new());
+            }
+            lines.push("Parameters:".into());
+            for p in documented {
+                lines.push(format!("- `{}`: {}", p.name, p.docs.join(" ")));
+            }
+        }
+        let d = docs(&lines);
         if h.ret == Type::Unit {
             quote!(#d fn #id(&mut self, data: &Data #(, #ps: #tys)*);)
         } else {
@@ -229,6 +278,20 @@ pub(crate) fn module(
         sub_modules,
         sub_handles,
     } = Wiring::new(ir, names, ci);
+    // A `reads`/`writes` declaration's doc comment, else the buffer's name.
+    let buffer_docs = |list: &[BufferId]| -> Vec<TokenStream> {
+        list.iter()
+            .map(|b| match c.buffer_docs.iter().find(|(x, _)| x == b) {
+                Some((_, lines)) => docs(lines),
+                None => {
+                    let d = format!(" Global Memory buffer `{}`.", ir.buffers[b.index()].name);
+                    quote!(#[doc = #d])
+                }
+            })
+            .collect()
+    };
+    let read_docs = buffer_docs(&c.reads);
+    let write_docs = buffer_docs(&c.writes);
     let sub_fields = &n.subs;
     let var_fields = &n.vars;
     let var_tys: Vec<_> = c.vars.iter().map(|v| rust_type(names, &v.ty)).collect();
@@ -238,6 +301,7 @@ pub(crate) fn module(
         names,
         ctrl: c,
         ci,
+        cached: &[],
     };
     let var_defaults_derivable = c
         .vars
@@ -350,7 +414,6 @@ pub(crate) fn module(
 
     quote! {
         #mod_docs
-        #[doc = #title]
         pub mod #module {
             use ::rcs_runtime as rt;
 
@@ -358,6 +421,8 @@ pub(crate) fn module(
             pub const NAME: &str = #name;
 
             #command_enum
+
+            #names_fns
 
             #[doc = #status_doc]
             pub mod status {
@@ -428,11 +493,11 @@ pub(crate) fn module(
 
             /// The Global Memory buffers this controller reads, as copied in this cycle.
             #[derive(Clone, Copy, Debug, Default, PartialEq)]
-            pub struct Reads { #(pub #read_fields: #read_tys),* }
+            pub struct Reads { #(#read_docs pub #read_fields: #read_tys),* }
 
             /// The Global Memory buffers this controller alone writes.
             #[derive(Clone, Copy, Debug, Default, PartialEq)]
-            pub struct Writes { #(pub #write_fields: #write_tys),* }
+            pub struct Writes { #(#write_docs pub #write_fields: #write_tys),* }
 
             /// The subordinates' statuses, seen through the handshake.
             #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -448,9 +513,13 @@ pub(crate) fn module(
             pub struct Data {
                 /// The command being executed.
                 pub command: Command,
+                /// The buffers read, copied in at the start of the cycle.
                 pub reads: Reads,
+                /// The subordinates' statuses this cycle.
                 pub subs: Subs,
+                /// The world-model variables.
                 pub vars: Vars,
+                /// The buffers written, copied out at the end of the cycle.
                 pub writes: Writes,
             }
 
@@ -497,13 +566,21 @@ pub(crate) fn module(
                 pub fn bookkeeping(&self) -> &rt::Bookkeeping { &self.bk }
                 /// The current status, typed.
                 pub fn status(&self) -> Option<Status> { Status::from_raw(self.bk.status()) }
+                /// The verb being executed, by name (`None` before the first command).
+                pub fn verb_name(&self) -> Option<&'static str> {
+                    if self.bk.echo_serial() == 0 { None } else { verb_name(self.bk.verb()) }
+                }
+                /// The state of the plan being executed, by name (`None` before the first command).
+                pub fn state_name(&self) -> Option<&'static str> {
+                    if self.bk.echo_serial() == 0 { None } else { state_name(self.bk.verb(), self.bk.state()) }
+                }
 
                 #decide
 
                 #(#plan_fns)*
             }
 
-            impl<H: Hooks> rt::Controller for Controller<H> {
+            impl<H: Hooks + 'static> rt::Controller for Controller<H> {
                 fn name(&self) -> &str { NAME }
 
                 fn cycle(&mut self, ctx: &rt::CycleContext) {
@@ -661,7 +738,27 @@ fn plan_fn(
         names,
         ctrl: c,
         ci,
+        cached: &[],
     };
+    // Each distinct hook call of the conditions runs at most once per
+    // cycle, on first use: its result waits in a local for the next row.
+    let cached = CachedCall::collect(
+        names,
+        ci,
+        p.rows.iter().filter_map(|r| match &r.cond {
+            Condition::When(e) => Some(e),
+            Condition::Otherwise => None,
+        }),
+    );
+    let cond_gen = Gen {
+        cached: &cached,
+        ..gen
+    };
+    let cache_locals = cached.iter().map(|k| {
+        let local = &k.local;
+        let ty = rust_type(names, &c.hooks[k.hook.index()].ret);
+        quote!(let mut #local: Option<#ty> = None;)
+    });
     let printer = Printer::new(ir, c, Some(p));
     let subs_param = if uses_subs(p) {
         quote!(subs: Subs,)
@@ -681,6 +778,9 @@ fn plan_fn(
             printer.target(r),
             r.line
         );
+        // The row's doc comment, then the row as written.
+        let doc_markers: Vec<TokenStream> =
+            r.docs.iter().map(|l| comments.marker(l.clone())).collect();
         let marker = comments.marker(text);
         let jobs: Vec<TokenStream> = r.jobs.iter().map(|j| gen.job(j)).collect();
         let pos = r.position as u16;
@@ -698,12 +798,13 @@ fn plan_fn(
             }
         };
         let body = quote! {
+            #(#doc_markers)*
             #marker
             #(#jobs)*
             self.bk.fire(#pos, #target);
         };
         let cond = match &r.cond {
-            Condition::When(e) => Some(gen.expr(e)),
+            Condition::When(e) => Some(cond_gen.expr(e)),
             Condition::Otherwise => None,
         };
         (cond, body)
@@ -794,27 +895,13 @@ fn plan_fn(
             }
         }
     };
-    let doc = format!(" Plan `{}` ({} rows).", cmd.name, p.rows.len());
+    let rows_word = if p.rows.len() == 1 { "row" } else { "rows" };
+    let doc = format!(" Plan `{}` ({} {rows_word}).", cmd.name, p.rows.len());
+    let plan_docs = paragraph(&p.docs);
     quote! {
-        #[doc = #doc]
-        // Conditions are the plan's own, verbatim: redundant or duplicated
-        // logic in a plan is the plan's (rcsc's checks report what matters,
-        // e.g. `shadowed_row`) and must not fail the user's clippy run.
-        #[allow(
-            unused_comparisons,
-            clippy::nonminimal_bool,
-            clippy::overly_complex_bool_expr,
-            clippy::eq_op,
-            clippy::redundant_comparisons,
-            clippy::double_comparisons,
-            clippy::ifs_same_cond,
-            clippy::identity_op,
-            clippy::erasing_op,
-            clippy::absurd_extreme_comparisons,
-            clippy::manual_range_contains,
-            clippy::approx_constant
-        )]
+        #[doc = #doc] #plan_docs
         fn #func(&mut self, #subs_param #(#args),*) {
+            #(#cache_locals)*
             #body
         }
     }

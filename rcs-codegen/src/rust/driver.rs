@@ -139,25 +139,36 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
         let id = &n.hooks[hi];
         let tys = h.params.iter().map(|p| rust_type(names, &p.ty));
         let blanks = h.params.iter().map(|_| quote!(_));
+        let i = proc_macro2::Literal::usize_unsuffixed(hi);
+        let count = quote!(self.call_counts[#i] = self.call_counts[#i].saturating_add(1););
         if h.ret == Type::Unit {
-            quote!(fn #id(&mut self, _: &Data #(, #blanks: #tys)*) {})
+            quote!(fn #id(&mut self, _: &Data #(, #blanks: #tys)*) { #count })
         } else {
             let ret = rust_type(names, &h.ret);
-            quote!(fn #id(&mut self, _: &Data #(, #blanks: #tys)*) -> #ret { self.#id })
+            quote!(fn #id(&mut self, _: &Data #(, #blanks: #tys)*) -> #ret { #count self.#id })
         }
     });
+    let hook_count = proc_macro2::Literal::usize_unsuffixed(c.hooks.len());
     let hooks_default = if c.hooks.iter().all(|h| derivable_default(&h.ret)) {
         quote! {
             #[derive(Clone, Copy, Debug, Default, PartialEq)]
-            pub struct ScriptedHooks { #(pub #hook_fields: #hook_tys),* }
+            pub struct ScriptedHooks {
+                #(pub #hook_fields: #hook_tys,)*
+                /// Calls of each hook since the last cycle's record.
+                pub call_counts: [u32; #hook_count],
+            }
         }
     } else {
         let zeros = c.hooks.iter().map(|h| zero(names, &h.ret));
         quote! {
             #[derive(Clone, Copy, Debug, PartialEq)]
-            pub struct ScriptedHooks { #(pub #hook_fields: #hook_tys),* }
+            pub struct ScriptedHooks {
+                #(pub #hook_fields: #hook_tys,)*
+                /// Calls of each hook since the last cycle's record.
+                pub call_counts: [u32; #hook_count],
+            }
             impl Default for ScriptedHooks {
-                fn default() -> Self { Self { #(#hook_fields: #zeros),* } }
+                fn default() -> Self { Self { #(#hook_fields: #zeros,)* call_counts: [0; #hook_count] } }
             }
         }
     };
@@ -320,6 +331,8 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
                 };
                 rt::Controller::cycle(&mut self.controller, &ctx);
                 self.cycle += 1;
+                let hook_calls = self.controller.hooks().call_counts.to_vec();
+                self.controller.hooks_mut().call_counts = [0; #hook_count];
                 let bk = self.controller.bookkeeping();
                 #bind_data
                 #dv::Record {
@@ -332,6 +345,7 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
                     sent: #sent_body,
                     vars: vec![#(#dv::ToValue::to_value(&data.vars.#var_fields)),*],
                     writes: vec![#(#dv::ToValue::to_value(&data.writes.#write_fields)),*],
+                    hook_calls,
                 }
             }
         }

@@ -55,6 +55,64 @@ pub(crate) struct Gen<'a> {
     pub names: &'a Names,
     pub ctrl: &'a Controller,
     pub ci: usize,
+    /// In a plan's conditions: its distinct hook calls, each read through
+    /// its lazily filled local (empty for jobs and constants).
+    pub cached: &'a [CachedCall],
+}
+
+/// A distinct hook call (same hook, syntactically equal arguments) of a
+/// plan's conditions: evaluated at most once per cycle, on first use, into
+/// `local: Option<T>`.
+pub(crate) struct CachedCall {
+    pub hook: HookId,
+    pub args: Vec<Expr>,
+    pub local: proc_macro2::Ident,
+}
+
+impl CachedCall {
+    /// The distinct hook calls of these conditions, inner calls first;
+    /// each hook's locals are numbered `<hook>_0`, `<hook>_1`, …
+    pub fn collect<'e>(
+        names: &Names,
+        ci: usize,
+        conds: impl Iterator<Item = &'e Expr>,
+    ) -> Vec<CachedCall> {
+        let mut calls: Vec<CachedCall> = Vec::new();
+        for c in conds {
+            collect_calls(c, &mut |h, args| {
+                if calls.iter().any(|k| k.hook == h && k.args == args) {
+                    return;
+                }
+                let nth = calls.iter().filter(|k| k.hook == h).count();
+                let hook = names.ctrls[ci].hooks[h.index()].to_string();
+                calls.push(CachedCall {
+                    hook: h,
+                    args: args.to_vec(),
+                    local: format_ident!("{}_{nth}", hook.trim_start_matches("r#")),
+                });
+            });
+        }
+        calls
+    }
+}
+
+/// Every hook call in `e`, arguments before the call that takes them.
+fn collect_calls(e: &Expr, f: &mut dyn FnMut(HookId, &[Expr])) {
+    match &e.kind {
+        ExprKind::Field(x, _)
+        | ExprKind::Index(x, _)
+        | ExprKind::Unary(_, x)
+        | ExprKind::Cast(x) => collect_calls(x, f),
+        ExprKind::Binary(_, l, r) => {
+            collect_calls(l, f);
+            collect_calls(r, f);
+        }
+        ExprKind::Call(h, args) => {
+            args.iter().for_each(|a| collect_calls(a, f));
+            f(*h, args);
+        }
+        _ => {}
+    }
 }
 
 pub(crate) fn rust_type(names: &Names, t: &Type) -> TokenStream {
@@ -350,10 +408,28 @@ impl Gen<'_> {
         }
     }
 
+    /// A hook call; in a condition, read through its cache local (see
+    /// [`CachedCall`]), so that it runs at most once per cycle.
+    fn call(&self, h: HookId, args: &[Expr]) -> Code {
+        let code = self.direct_call(h, args);
+        match self.cached.iter().find(|k| k.hook == h && k.args == args) {
+            Some(k) => {
+                let local = &k.local;
+                let inner = &code.ts;
+                Code {
+                    ts: quote!(*#local.get_or_insert_with(|| #inner)),
+                    prec: UNARY,
+                    has_block: code.has_block,
+                }
+            }
+            None => code,
+        }
+    }
+
     /// `self.hooks.name(&self.data, args…)`. Arguments that call hooks
     /// themselves are evaluated first into locals (a block), because the
     /// outer call already borrows the hooks mutably.
-    fn call(&self, h: HookId, args: &[Expr]) -> Code {
+    fn direct_call(&self, h: HookId, args: &[Expr]) -> Code {
         let name = &self.cn().hooks[h.index()];
         let codes: Vec<Code> = args.iter().map(|a| self.expr(a)).collect();
         let nested = args.iter().any(contains_call);

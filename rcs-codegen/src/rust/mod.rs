@@ -41,8 +41,11 @@ impl Comments {
                 Some(n) => {
                     let indent = &line[..line.len() - trimmed.len()];
                     out.push_str(indent);
-                    out.push_str("// ");
-                    out.push_str(&self.texts[n]);
+                    out.push_str("//");
+                    if !self.texts[n].is_empty() {
+                        out.push(' ');
+                        out.push_str(&self.texts[n]);
+                    }
                 }
                 None => out.push_str(line),
             }
@@ -90,6 +93,23 @@ pub fn system_module(ir: &Ir, options: &crate::Options) -> String {
     let tokens = quote! {
         #[doc = #doc]
         pub mod #system_ident {
+            // Conditions are the plan's own, verbatim: redundant or duplicated
+            // logic in a plan is the plan's (rcsc's checks report what matters,
+            // e.g. `shadowed_row`) and must not fail the user's clippy run.
+            #![allow(
+                unused_comparisons,
+                clippy::nonminimal_bool,
+                clippy::overly_complex_bool_expr,
+                clippy::eq_op,
+                clippy::redundant_comparisons,
+                clippy::double_comparisons,
+                clippy::ifs_same_cond,
+                clippy::identity_op,
+                clippy::erasing_op,
+                clippy::absurd_extreme_comparisons,
+                clippy::manual_range_contains,
+                clippy::approx_constant
+            )]
             use ::rcs_runtime as rt;
             #types
             #(#controllers)*
@@ -184,5 +204,77 @@ mod tests {
         assert!(on.contains("impl ::rcs_runtime::driver::Driven for Driver"));
         assert!(on.contains("pub fn new_driver("));
         assert!(on.contains("impl ::rcs_runtime::driver::FromValue for Big"));
+    }
+
+    #[test]
+    fn doc_comments_reach_the_rust_items_they_document() {
+        let set = rcs_dsl::PlanSet::from_texts(
+            "t",
+            [(
+                "t.rcs",
+                "buffer B { x: f64 }\n\
+                 /// Controller A.\n\
+                 controller A \"Title\" {\n\
+                 /// Read doc.\n    reads b: B\n\
+                 /// Write doc.\n    writes c: B\n\
+                 command GO(\n        /// Param doc.\n        speed: f64,\n    )\n\
+                 hook h(\n        /// Hook param doc.\n        n: f64,\n    )\n\
+                 /// Plan doc.\n    plan GO {\n\
+                 /// Row doc.\n        *0 when new_command -> Done { c.x = cmd.speed; h(b.x) }\n    }\n}\n",
+            )],
+            None,
+        );
+        let ir = rcs_dsl::check(&set, &rcs_dsl::Options::default())
+            .ir
+            .expect("clean");
+        let text = super::system_module(&ir, &crate::Options::default());
+        let lines: Vec<&str> = text.lines().map(str::trim).collect();
+        let before = |doc: &str, item: &str| {
+            assert!(
+                lines
+                    .windows(2)
+                    .any(|w| w[0] == doc && w[1].starts_with(item)),
+                "no `{doc}` right above `{item}` in\n{text}"
+            );
+        };
+        before("/// Read doc.", "pub b: super::types::B");
+        before("/// Write doc.", "pub c: super::types::B");
+        before("/// Param doc.", "speed: f64");
+        before("/// - `n`: Hook param doc.", "fn h(");
+        before("/// Plan doc.", "#[derive");
+        before("/// Plan doc.", "fn plan_go(");
+        before("// Row doc.", "// E0: *0 when new_command -> Done");
+        // The controller's doc comment stands for its title.
+        before("/// Controller A.", "pub mod a {");
+        assert!(!text.contains("`A`: Title."));
+    }
+
+    #[test]
+    fn the_hooks_and_system_types_do_not_depend_on_file_names() {
+        let zed = "controller Z {\n    command GO\n    hook z() -> bool\n    plan GO { *0 when new_command && z() -> Done }\n}\n";
+        let ant = "controller A {\n    command GO\n    hook a() -> bool\n    plan GO { *0 when new_command && a() -> Done }\n}\n";
+        let api = |files: [(&str, &str); 2]| -> Vec<String> {
+            let set = rcs_dsl::PlanSet::from_texts("t", files, None);
+            let ir = rcs_dsl::check(&set, &rcs_dsl::Options::default())
+                .ir
+                .expect("clean");
+            super::system_module(&ir, &crate::Options::default())
+                .lines()
+                .map(str::trim)
+                .filter(|l| {
+                    l.starts_with("pub struct Hooks")
+                        || l.starts_with("pub struct System")
+                        || l.starts_with("impl<")
+                })
+                .map(String::from)
+                .collect()
+        };
+        let one = api([("1.rcs", zed), ("2.rcs", ant)]);
+        let other = api([("2.rcs", ant), ("9.rcs", zed)]);
+        assert!(
+            one.contains(&"pub struct Hooks<AHooks, ZHooks> {".to_string()),
+            "{one:?}"
+        );
+        assert_eq!(one, other);
     }
 }

@@ -4,6 +4,8 @@
 //! operator's handle on each root controller.
 
 use super::names::Names;
+use crate::ident::camel;
+use proc_macro2::Ident;
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 use rcs_dsl::ir::Ir;
@@ -22,6 +24,31 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
     let written: Vec<usize> = (0..ir.buffers.len())
         .filter(|b| ir.buffers[*b].writer.is_some())
         .collect();
+    // A buffer's docs: those of a `reads`/`writes` declaration of it, if
+    // any has some (its writer's first), else its name and type.
+    let buffer_doc = |b: usize| -> TokenStream {
+        let declared = ir.buffers[b]
+            .writer
+            .iter()
+            .chain(&ir.buffers[b].readers)
+            .find_map(|c| {
+                ir.controllers[c.index()]
+                    .buffer_docs
+                    .iter()
+                    .find(|(x, _)| x.index() == b)
+            });
+        let lines: Vec<String> = match declared {
+            Some((_, lines)) => lines.iter().map(|l| format!(" {l}")).collect(),
+            None => vec![format!(
+                " Buffer `{}` (`{}`).",
+                ir.buffers[b].name,
+                ir.buffer_types[ir.buffers[b].ty.index()].name
+            )],
+        };
+        quote!(#(#[doc = #lines])*)
+    };
+    let in_docs: Vec<TokenStream> = external.iter().map(|b| buffer_doc(*b)).collect();
+    let out_docs: Vec<TokenStream> = written.iter().map(|b| buffer_doc(*b)).collect();
     let in_fields: Vec<_> = external.iter().map(|b| &names.gm_buffers[*b]).collect();
     let in_tys: Vec<_> = external.iter().map(|b| ty_of(*b)).collect();
     let in_names: Vec<&str> = external
@@ -38,44 +65,81 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
     let roots: Vec<usize> = (0..ir.controllers.len())
         .filter(|c| ir.controllers[*c].supervisor.is_none())
         .collect();
+    let root_docs: Vec<String> = roots
+        .iter()
+        .map(|c| {
+            format!(
+                " Commands `{}` and reads its status.",
+                ir.controllers[*c].name
+            )
+        })
+        .collect();
     let root_fields: Vec<_> = roots.iter().map(|c| &names.ctrls[*c].module).collect();
     let root_names: Vec<&str> = roots
         .iter()
         .map(|c| ir.controllers[*c].name.as_str())
         .collect();
 
-    // One hooks argument per controller that has hooks.
-    let hooked: Vec<usize> = (0..ir.controllers.len())
-        .filter(|c| !ir.controllers[*c].hooks.is_empty())
-        .collect();
-    let hook_params: Vec<_> = hooked
+    // One field of `Hooks`, and one type parameter, per controller that
+    // has hooks: passed by name, so the order of files never matters.
+    let hooked = hooked(ir);
+    let hook_fields: Vec<&Ident> = hooked.iter().map(|c| &names.ctrls[*c].module).collect();
+    let hook_generics: Vec<Ident> = hooked
         .iter()
         .map(|c| {
             format_ident!(
-                "{}_hooks",
-                names.ctrls[*c].module.to_string().trim_start_matches("r#")
+                "{}Hooks",
+                camel(&names.ctrls[*c].module.to_string().replace("r#", ""))
             )
         })
         .collect();
-    let hook_generics: Vec<_> = hooked.iter().map(|c| format_ident!("H{}", *c)).collect();
-    let hook_bounds = hooked.iter().zip(&hook_generics).map(|(c, g)| {
-        let m = &names.ctrls[*c].module;
-        quote!(#g: #m::Hooks + 'static)
-    });
+    let hook_bounds: Vec<TokenStream> = hooked
+        .iter()
+        .zip(&hook_generics)
+        .map(|(c, g)| {
+            let m = &names.ctrls[*c].module;
+            quote!(#g: #m::Hooks + 'static)
+        })
+        .collect();
+    let hook_field_docs: Vec<String> = hooked
+        .iter()
+        .map(|c| format!(" The hooks of `{}`.", ir.controllers[*c].name))
+        .collect();
+    let generics = if hooked.is_empty() {
+        quote!()
+    } else {
+        quote!(<#(#hook_generics),*>)
+    };
+    let bounds = if hooked.is_empty() {
+        quote!()
+    } else {
+        quote!(<#(#hook_bounds),*>)
+    };
+    let hooks_param = if hooked.is_empty() {
+        quote!(_hooks)
+    } else {
+        quote!(hooks)
+    };
+    // The hook type of each controller inside a `System`.
+    let hooks_of = |c: usize| match hooked.iter().position(|h| *h == c) {
+        Some(i) => {
+            let g = &hook_generics[i];
+            quote!(#g)
+        }
+        None => quote!(()),
+    };
 
     let executives = ir.schedule.iter().map(|cpu| {
         let name = &cpu.name;
         let period = cpu.period_ns;
         let adds = cpu.order.iter().map(|c| {
             let m = &names.ctrls[c.index()].module;
-            let hooks = match hooked.iter().position(|h| *h == c.index()) {
-                Some(i) => {
-                    let p = &hook_params[i];
-                    quote!(#p)
-                }
-                None => quote!(()),
+            let arg = if ir.controllers[c.index()].hooks.is_empty() {
+                quote!(())
+            } else {
+                quote!(hooks.#m)
             };
-            quote!(exec.add(Box::new(#m::Controller::new(&gm, #hooks)?))?;)
+            quote!(exec.add(Box::new(#m::Controller::new(&gm, #arg)?))?;)
         });
         quote! {{
             let mut exec = rt::Executive::new(rt::ExecutiveConfig::new(#name, ::core::time::Duration::from_nanos(#period)))?;
@@ -83,53 +147,81 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
             executives.push(exec);
         }}
     });
-    let hooks_doc: Vec<String> = hooked
-        .iter()
-        .map(|c| {
-            format!(
-                " - `{}`: the hooks of `{}`",
-                hook_params[hooked.iter().position(|h| h == c).unwrap_or(0)],
-                ir.controllers[*c].name
-            )
-        })
-        .collect();
     let system_doc = format!(
         " The `{}` system: Global Memory, its executives and the handles the outside world uses.",
         ir.system
     );
+    let example = system_example(ir, names);
+    let accessors = (0..ir.controllers.len()).map(|c| {
+        let m = &names.ctrls[c].module;
+        let base = accessor(m);
+        let get = crate::ident::ident(&base);
+        let get_mut = format_ident!("{base}_mut");
+        let h = hooks_of(c);
+        let name = &ir.controllers[c].name;
+        let doc = format!(
+            " `{name}`, typed: its data, hooks, status, verb and state. `None` while its executive is out of `executives` (taken to run on a thread)."
+        );
+        let doc_mut = format!(" `{name}`, typed and mutable (its hooks, between cycles)."); 
+        quote! {
+            #[doc = #doc]
+            pub fn #get(&self) -> Option<&#m::Controller<#h>> {
+                self.executives.iter().find_map(|e| e.controller_as(#m::NAME))
+            }
+            #[doc = #doc_mut]
+            pub fn #get_mut(&mut self) -> Option<&mut #m::Controller<#h>> {
+                self.executives.iter_mut().find_map(|e| e.controller_as_mut(#m::NAME))
+            }
+        }
+    });
 
     quote! {
         /// Global Memory buffers no controller writes: sensor drivers and
         /// simulators write them through these handles (one writer each).
         #[derive(Debug)]
-        pub struct Inputs { #(pub #in_fields: rt::Writer<#in_tys>),* }
+        pub struct Inputs { #(#in_docs pub #in_fields: rt::Writer<#in_tys>),* }
 
         /// Readers of the buffers the controllers write, for actuators,
         /// simulators and displays.
         #[derive(Clone, Debug)]
-        pub struct Outputs { #(pub #out_fields: rt::Reader<#out_tys>),* }
+        pub struct Outputs { #(#out_docs pub #out_fields: rt::Reader<#out_tys>),* }
 
         /// The operator's handle on each root controller (§3.7): the only
         /// way in, through the root's command buffer.
         #[derive(Debug)]
-        pub struct Operators { #(pub #root_fields: rt::Operator<#root_fields::Command>),* }
+        pub struct Operators { #(#[doc = #root_docs] pub #root_fields: rt::Operator<#root_fields::Command>),* }
+
+        /// The hand-written hooks of each controller that has some, by the
+        /// controller's name: what [`System::new`] builds the controllers with.
+        #[derive(Clone, Debug, Default)]
+        pub struct Hooks #generics { #(#[doc = #hook_field_docs] pub #hook_fields: #hook_generics),* }
 
         #[doc = #system_doc]
+        ///
+        /// # Example
+        ///
+        /// ```ignore
+        #(#[doc = #example])*
+        /// ```
         #[derive(Debug)]
-        pub struct System {
+        pub struct System #generics {
             /// Global Memory, shared by every executive.
             pub gm: rt::GlobalMemory,
             /// One executive per CPU of the schedule, in schedule order.
             pub executives: Vec<rt::Executive>,
+            /// Writers of the external inputs.
             pub inputs: Inputs,
+            /// Readers of the buffers the controllers write.
             pub outputs: Outputs,
+            /// The operator's handle on each root controller.
             pub operators: Operators,
+            hooks: ::core::marker::PhantomData<fn() -> (#(#hook_generics,)*)>,
         }
 
-        impl System {
-            /// Set up Global Memory and the executives. Hooks:
-            #(#[doc = #hooks_doc])*
-            pub fn new<#(#hook_bounds),*>(#(#hook_params: #hook_generics),*) -> Result<Self, rt::SetupError> {
+        impl #bounds System #generics {
+            /// Set up Global Memory and the executives, each controller with
+            /// its hooks from `hooks`.
+            pub fn new(#hooks_param: Hooks #generics) -> Result<Self, rt::SetupError> {
                 let gm = rt::GlobalMemory::new();
                 #(gm.declare::<#all_tys>(#all_names)?;)*
                 let mut executives = Vec::new();
@@ -140,8 +232,11 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
                     operators: Operators { #(#root_fields: rt::Operator::connect(&gm, #root_names)?),* },
                     gm,
                     executives,
+                    hooks: ::core::marker::PhantomData,
                 })
             }
+
+            #(#accessors)*
 
             /// Run `n` cycles as fast as possible on this thread, the
             /// executives interleaved cycle by cycle (tests and simulation).
@@ -154,4 +249,107 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
             }
         }
     }
+}
+
+/// The text of `System`'s rustdoc example, one line a `#[doc]`: build with
+/// hooks by name, feed the inputs, command the root, run cycles, read an
+/// output and each controller's state by name (docs/using-generated-code.md
+/// walks through the same steps and is tested).
+fn system_example(ir: &Ir, names: &Names) -> Vec<String> {
+    let system = crate::ident::snake(&ir.system);
+    let mut lines = vec![format!("rcs_runtime::include_plans!({:?});", ir.system)];
+    lines.push(format!("use {system}::{{Hooks, System}};"));
+    lines.push(String::new());
+    let hooked = hooked(ir);
+    if hooked.is_empty() {
+        lines.push("let mut system = System::new(Hooks {})?;".into());
+    } else {
+        lines.push("let mut system = System::new(Hooks {".into());
+        for c in &hooked {
+            let m = names.ctrls[*c].module.to_string().replace("r#", "");
+            lines.push(format!(
+                "    {m}: my_{m}_hooks, // your `impl {system}::{m}::Hooks`"
+            ));
+        }
+        lines.push("})?;".into());
+    }
+    for (b, buf) in ir.buffers.iter().enumerate() {
+        if buf.writer.is_none() {
+            let f = names.gm_buffers[b].to_string().replace("r#", "");
+            let ty = &names.buffers[buf.ty.index()].ty;
+            lines.push(format!(
+                "system.inputs.{f}.write({system}::types::{ty}::default(), 0);"
+            ));
+        }
+    }
+    for (c, ctrl) in ir.controllers.iter().enumerate() {
+        if ctrl.supervisor.is_none() {
+            let m = names.ctrls[c].module.to_string().replace("r#", "");
+            lines.push(format!(
+                "system.operators.{m}.command({system}::{m}::Command::default());"
+            ));
+        }
+    }
+    lines.push("system.run_cycles(10);".into());
+    if let Some((b, _)) = ir
+        .buffers
+        .iter()
+        .enumerate()
+        .find(|(_, b)| b.writer.is_some())
+    {
+        let f = names.gm_buffers[b].to_string().replace("r#", "");
+        lines.push(format!("let {f} = system.outputs.{f}.read().value;"));
+    }
+    if let Some(c) = ir.controllers.first() {
+        let m = accessor(&names.ctrls[0].module);
+        lines.push(format!("if let Some({m}) = system.{m}() {{"));
+        lines.push(format!(
+            "    println!(\"{}: {{:?}} {{:?}} {{:?}}\", {m}.verb_name(), {m}.state_name(), {m}.status());",
+            c.name
+        ));
+        lines.push("}".into());
+    }
+    lines.extend(
+        [
+            "",
+            "// Timing: per executive, and per controller (nanoseconds).",
+            "let exec = &system.executives[0];",
+            "println!(\"{} cycles, {} overruns\", exec.stats().cycles, exec.overruns());",
+            "",
+            "// Real time: each executive on its own thread, on its heartbeat.",
+            "let mut running = Vec::new();",
+            "for exec in std::mem::take(&mut system.executives) {",
+            "    running.push(exec.spawn()?);",
+            "}",
+            "std::thread::sleep(std::time::Duration::from_secs(1)); // write inputs, read outputs",
+            "for (handle, join) in running {",
+            "    handle.stop();",
+            "    system.executives.push(join.join().expect(\"executive thread\"));",
+            "}",
+        ]
+        .map(String::from),
+    );
+    lines.iter().map(|l| format!(" {l}")).collect()
+}
+
+/// The name of `System`'s accessor of the controller in module `module`:
+/// the module's name, unless a method of `System` has it.
+fn accessor(module: &Ident) -> String {
+    let base = module.to_string().replace("r#", "");
+    if ["new", "run_cycles"].contains(&base.as_str()) {
+        format!("{base}_controller")
+    } else {
+        base
+    }
+}
+
+/// The controllers with hooks, by name: the fields and type parameters of
+/// `Hooks` and `System` in this order, so that renaming or reordering the
+/// plan set's files never changes them.
+fn hooked(ir: &Ir) -> Vec<usize> {
+    let mut hooked: Vec<usize> = (0..ir.controllers.len())
+        .filter(|c| !ir.controllers[*c].hooks.is_empty())
+        .collect();
+    hooked.sort_by(|a, b| ir.controllers[*a].name.cmp(&ir.controllers[*b].name));
+    hooked
 }

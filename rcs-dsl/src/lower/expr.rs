@@ -180,6 +180,7 @@ fn lower_params(g: &Globals, params: &[ast::Param], diags: &mut Diagnostics) -> 
         let ty = resolve_type(g, &p.ty, diags).unwrap_or(Type::Unit);
         out.push(Param {
             name: p.name.text.to_string(),
+            docs: p.docs.clone(),
             ty,
             span: p.name.span,
         });

@@ -359,6 +359,7 @@ fn lower_controller_headers<'a>(
             subordinate_spans: Vec::new(),
             subordinates_lists: Vec::new(),
             buffer_spans: Vec::new(),
+            buffer_docs: Vec::new(),
         });
     }
     // Where each controller was named as a subordinate, for multiple_supervisors.
@@ -557,6 +558,11 @@ fn lower_controller_headers<'a>(
                         ir.controllers[i].reads.push(bid);
                     }
                     ir.controllers[i].buffer_spans.push((bid, name.span));
+                    if !e.outer.docs.is_empty() {
+                        ir.controllers[i]
+                            .buffer_docs
+                            .push((bid, e.outer.docs.clone()));
+                    }
                 }
                 _ => {}
             }

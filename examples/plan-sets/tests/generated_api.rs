@@ -1,0 +1,78 @@
+//! The generated `System`'s API on the submarine plans: hooks passed by
+//! controller name, each controller reachable typed (its hooks, data,
+//! status, verb and state by name) while its executive is in the system,
+//! and the per-controller `verb_name` / `state_name` functions.
+
+use rcs_plan_sets::set_submarine::submarine::types::{SpeedError, TurbineSensors};
+use rcs_plan_sets::set_submarine::submarine::{pr, sm, tb, Hooks, System};
+
+/// PR's hooks, with a field the test reads back through `system.pr()`.
+#[derive(Debug)]
+struct Model {
+    asked: u32,
+}
+
+impl pr::Hooks for Model {
+    fn required_rpm(&mut self, _: &pr::Data, speed: f64) -> f64 {
+        self.asked += 1;
+        10.0 * speed
+    }
+    fn speed_error(&mut self, _: &pr::Data) -> SpeedError {
+        SpeedError::Below
+    }
+}
+
+#[test]
+fn names_of_verbs_and_states_come_from_the_plans() {
+    assert_eq!(pr::verb_name(0), Some("INIT"));
+    assert_eq!(pr::verb_name(2), Some("AHEAD"));
+    assert_eq!(pr::verb_name(3), None);
+    assert_eq!(tb::verb_name(3), Some("STOP"));
+    assert_eq!(sm::state_name(1, 2), Some("S2"));
+    assert_eq!(pr::state_name(2, 1), Some("S1"));
+    assert_eq!(pr::state_name(2, 9), None);
+    assert_eq!(pr::state_name(7, 0), None);
+}
+
+#[test]
+fn a_system_gives_typed_controllers_while_it_holds_their_executive() {
+    let mut system = System::new(Hooks {
+        pr: Model { asked: 0 },
+    })
+    .expect("setup");
+    let pr = system.pr().expect("PR");
+    assert_eq!((pr.verb_name(), pr.state_name()), (None, None));
+    assert_eq!(pr.status(), Some(pr::Status::NotReady));
+
+    system.inputs.turbine.write(TurbineSensors { rpm: 0.0 }, 0);
+    system
+        .operators
+        .sm
+        .command(sm::Command::Transit { speed: 4.0 });
+    system.run_cycles(2);
+    let pr = system.pr().expect("PR");
+    assert_eq!(pr.verb_name(), Some("AHEAD"));
+    assert_eq!(pr.state_name(), Some("S1"));
+    assert_eq!(pr.status(), Some(pr::Status::Executing));
+    assert_eq!(pr.data().command, pr::Command::Ahead { speed: 4.0 });
+    assert_eq!(pr.hooks().asked, 1);
+    let tb = system.tb().expect("TB");
+    assert_eq!(
+        (tb.verb_name(), tb.state_name()),
+        (Some("AHEAD"), Some("S1"))
+    );
+    assert_eq!(system.outputs.drive.read().value.rpm_setpoint, 40.0);
+
+    system.pr_mut().expect("PR").hooks_mut().asked = 10;
+    assert_eq!(system.pr().map(|pr| pr.hooks().asked), Some(10));
+
+    // Out of the system (to run on a thread), an executive's controllers
+    // are not reachable; back in, they are.
+    let executives = std::mem::take(&mut system.executives);
+    assert!(system.pr().is_none() && system.sm().is_none());
+    system.executives = executives;
+    assert_eq!(
+        system.sm().and_then(|sm| sm.status()),
+        Some(sm::Status::Executing)
+    );
+}

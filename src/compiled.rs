@@ -78,21 +78,14 @@ fn runtime_files() -> Vec<rcs_codegen::OutputFile> {
     let note = format!("{generated} {version}: rcs-runtime's source, shipped inside rcsc");
     let mut files = vec![rcs_codegen::OutputFile {
         path: "Cargo.toml".to_string(),
-        contents: format!(
-            "# {note}.
-{}",
-            shipped::RUNTIME_MANIFEST
-        ),
+        contents: format!("# {note}.\n{}", shipped::RUNTIME_MANIFEST),
     }];
     files.extend(
         shipped::RUNTIME_FILES
             .iter()
             .map(|(path, contents)| rcs_codegen::OutputFile {
                 path: path.to_string(),
-                contents: format!(
-                    "// {note}.
-{contents}"
-                ),
+                contents: format!("// {note}.\n{contents}"),
             }),
     );
     files

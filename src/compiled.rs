@@ -6,10 +6,13 @@
 //! through a `Remote` per controller, so both backends are held to one
 //! reading of every scenario.
 //!
-//! The crate (`<target>/rcsc/driver/`) depends only on `rcs-runtime`; it is
-//! rewritten only where its files change and built by cargo with
-//! `--offline` first, so after the first build a run costs a second or
-//! two and needs no network.
+//! The crate (`<target>/rcsc/driver/`) depends only on `rcs-runtime`,
+//! whose source is shipped inside rcsc (`build.rs`) and written beside it
+//! (`<target>/rcsc/rcs-runtime/`), so an installed rcsc needs no checkout.
+//! Both are rewritten only where their files change and built by cargo
+//! with `--offline` first, from a lock file of the versions rcsc was built
+//! with, so after the first build a run costs a second or two and needs no
+//! network.
 
 use rcs_dsl::ir::Ir;
 use std::io::BufReader;
@@ -57,32 +60,71 @@ impl Drop for Driver {
     }
 }
 
-/// Where `rcs-runtime` comes from: `RCSC_RUNTIME_PATH`, else the source
-/// tree rcsc was built from, else crates.io.
-fn runtime_dependency() -> String {
-    let local = std::env::var_os("RCSC_RUNTIME_PATH")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("rcs-runtime"));
-    if local.join("Cargo.toml").is_file() {
+/// `rcs-runtime`'s source, shipped inside rcsc by `build.rs`:
+/// `RUNTIME_FILES` and `RUNTIME_MANIFEST`.
+mod shipped {
+    include!(concat!(env!("OUT_DIR"), "/runtime.rs"));
+}
+
+/// The folder (beside the driver's) where the shipped runtime is written.
+const RUNTIME_DIR: &str = "rcs-runtime";
+
+/// The runtime crate as files: the shipped source and its standalone
+/// manifest, each marked generated in its first line (so a file a newer
+/// rcsc no longer ships is removed) (pure).
+fn runtime_files() -> Vec<rcs_codegen::OutputFile> {
+    let generated = rcs_codegen::GENERATED;
+    let version = env!("CARGO_PKG_VERSION");
+    let note = format!("{generated} {version}: rcs-runtime's source, shipped inside rcsc");
+    let mut files = vec![rcs_codegen::OutputFile {
+        path: "Cargo.toml".to_string(),
+        contents: format!("# {note}.\n{}", shipped::RUNTIME_MANIFEST),
+    }];
+    files.extend(
+        shipped::RUNTIME_FILES
+            .iter()
+            .map(|(path, contents)| rcs_codegen::OutputFile {
+                path: path.to_string(),
+                contents: format!("// {note}.\n{contents}"),
+            }),
+    );
+    files
+}
+
+/// Where `rcs-runtime` comes from: the folder `RCSC_RUNTIME_PATH` names (a
+/// checkout of the runtime, for working on it), else the copy shipped
+/// inside rcsc, written under `root` only where its files changed (so
+/// cargo sees it unchanged between runs). Returns the dependency's value
+/// for the driver's manifest.
+fn runtime_dependency(root: &Path) -> Result<String, String> {
+    if let Some(local) = std::env::var_os("RCSC_RUNTIME_PATH").map(PathBuf::from) {
+        if !local.join("Cargo.toml").is_file() {
+            return Err(format!(
+                "RCSC_RUNTIME_PATH={} is not a crate folder (no Cargo.toml); \
+                 unset it to use the runtime shipped inside rcsc",
+                local.display()
+            ));
+        }
+        let local = std::path::absolute(&local).unwrap_or(local);
         // TOML basic strings take `\` escapes; write the path with `/`.
         let path = local.display().to_string().replace('\\', "/");
-        format!("{{ path = {path:?} }}")
-    } else {
-        format!("\"={}\"", env!("CARGO_PKG_VERSION"))
+        return Ok(format!("{{ path = {path:?} }}"));
     }
+    rcs_codegen::writer::write_tree(&root.join(RUNTIME_DIR), &runtime_files())
+        .map_err(|e| format!("writing the runtime crate: {e}"))?;
+    Ok(format!("{{ path = \"../{RUNTIME_DIR}\" }}"))
 }
 
 /// The driver crate's files for these plan sets (pure).
-fn crate_files(irs: &[&Ir]) -> Vec<rcs_codegen::OutputFile> {
+fn crate_files(irs: &[&Ir], runtime: &str) -> Vec<rcs_codegen::OutputFile> {
     let generated = rcs_codegen::GENERATED;
     let mut files = vec![rcs_codegen::OutputFile {
         path: "Cargo.toml".to_string(),
         contents: format!(
             "# {generated}: the scenario driver of `rcsc test --backend compiled`.\n\
              [package]\nname = \"{PACKAGE}\"\nversion = \"0.0.0\"\nedition = \"2021\"\npublish = false\n\n\
-             [dependencies]\nrcs-runtime = {}\n\n\
-             # Its own workspace, wherever the target folder lives.\n[workspace]\n",
-            runtime_dependency()
+             [dependencies]\nrcs-runtime = {runtime}\n\n\
+             # Its own workspace, wherever the target folder lives.\n[workspace]\n"
         ),
     }];
     let mut modules = String::new();
@@ -124,7 +166,8 @@ pub fn build(irs: &[&Ir], target_dir: &Path, status: &dyn Fn(&str)) -> Result<Dr
     let root = target_dir.join("rcsc");
     let source = root.join("driver");
     let build_dir = root.join("driver-target");
-    let report = rcs_codegen::writer::write_tree(&source, &crate_files(irs))
+    let runtime = runtime_dependency(&root)?;
+    let report = rcs_codegen::writer::write_tree(&source, &crate_files(irs, &runtime))
         .map_err(|e| format!("writing the scenario driver: {e}"))?;
     let lock = source.join("Cargo.lock");
     if !lock.exists() {
@@ -159,10 +202,20 @@ pub fn build(irs: &[&Ir], target_dir: &Path, status: &dyn Fn(&str)) -> Result<Dr
         out = run(false).map_err(|e| format!("cannot run cargo: {e}"))?;
     }
     if !out.status.success() {
-        return Err(format!(
-            "building the scenario driver failed:\n{}",
-            String::from_utf8_lossy(&out.stderr).trim_end()
-        ));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let mut message = format!(
+            "building the scenario driver ({}) failed; cargo said:\n{}",
+            rcs_dsl::load::display(&source),
+            stderr.trim_end()
+        );
+        if stderr.contains("offline") || stderr.contains("registry") {
+            message.push_str(
+                "\nhelp: the driver needs rcs-runtime's dependencies (serde, serde_json, \
+                 thiserror) in cargo's registry cache, as after building or installing \
+                 rcsc, or access to crates.io",
+            );
+        }
+        return Err(message);
     }
     let mut child = Command::new(binary(&build_dir))
         .stdin(Stdio::piped())
@@ -192,7 +245,7 @@ mod tests {
     #[test]
     fn the_crate_names_every_set_and_is_marked_generated() {
         let ir = crate::tests::one_controller();
-        let files = crate_files(&[&ir, &ir]);
+        let files = crate_files(&[&ir, &ir], "{ path = \"../rcs-runtime\" }");
         let paths: Vec<&str> = files.iter().map(|f| f.path.as_str()).collect();
         assert_eq!(
             paths,
@@ -209,5 +262,66 @@ mod tests {
         assert!(files[1]
             .contents
             .contains("impl ::rcs_runtime::driver::Driven for Driver"));
+    }
+
+    /// The shipped runtime is the crate in this repository, file for file,
+    /// with a manifest cargo reads outside the workspace.
+    #[test]
+    fn the_shipped_runtime_is_the_real_one() {
+        let real = Path::new(env!("CARGO_MANIFEST_DIR")).join("rcs-runtime");
+        let mut on_disk = Vec::new();
+        let mut folders = vec![real.join("src")];
+        while let Some(dir) = folders.pop() {
+            for entry in std::fs::read_dir(dir).unwrap() {
+                let path = entry.unwrap().path();
+                if path.is_dir() {
+                    folders.push(path);
+                } else {
+                    on_disk.push(path);
+                }
+            }
+        }
+        let mut shipped: Vec<&str> = shipped::RUNTIME_FILES.iter().map(|f| f.0).collect();
+        let mut expected: Vec<String> = on_disk
+            .iter()
+            .map(|p| {
+                p.strip_prefix(&real)
+                    .unwrap()
+                    .to_str()
+                    .unwrap()
+                    .replace('\\', "/")
+            })
+            .collect();
+        shipped.sort_unstable();
+        expected.sort_unstable();
+        assert_eq!(shipped, expected);
+        for (path, contents) in shipped::RUNTIME_FILES {
+            assert_eq!(*contents, std::fs::read_to_string(real.join(path)).unwrap());
+        }
+
+        let manifest = shipped::RUNTIME_MANIFEST;
+        assert!(!manifest.contains("workspace"), "{manifest}");
+        assert!(
+            !manifest.contains("criterion"),
+            "no dev-dependencies:\n{manifest}"
+        );
+        for line in [
+            "name = \"rcs-runtime\"",
+            &format!("version = \"{}\"", env!("CARGO_PKG_VERSION")),
+            "edition = \"2021\"",
+            "[dependencies]",
+            "serde = { version = \"1\", features = [\"derive\"] }",
+            "serde_json = \"1\"",
+            "thiserror = \"2\"",
+        ] {
+            assert!(manifest.lines().any(|l| l == line), "{line}:\n{manifest}");
+        }
+        // Every file of the written crate is marked, so stale ones go.
+        assert!(runtime_files().iter().all(|f| f
+            .contents
+            .lines()
+            .next()
+            .unwrap()
+            .contains(rcs_codegen::GENERATED)));
     }
 }

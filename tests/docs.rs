@@ -334,7 +334,7 @@ fn the_readme_state_graph_is_up_to_date() {
     );
 }
 
-/// `docs/using-generated-code.md`, followed as a newcomer would: its
+/// The README's "Using the generated code", followed as a newcomer would: its
 /// `file=…` blocks make a crate outside the workspace (`/path/to/rcsc`
 /// becomes this checkout, and `plans/submarine` is copied in as its first
 /// step says), `cargo run` builds and runs it offline against this
@@ -343,8 +343,12 @@ fn the_readme_state_graph_is_up_to_date() {
 #[test]
 fn using_the_generated_code_works_as_written() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let doc = std::fs::read_to_string(root.join("docs/using-generated-code.md")).unwrap();
-    let blocks = blocks(&doc);
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let doc = readme
+        .split("\n## ")
+        .find(|s| s.starts_with("Using the generated code\n"))
+        .expect("README.md has a `## Using the generated code` section");
+    let blocks = blocks(doc);
     let mut files: Vec<(String, String)> = Vec::new();
     for b in &blocks {
         let Some(file) = b.attrs.iter().find_map(|a| a.strip_prefix("file=")) else {

@@ -1,5 +1,5 @@
 //! The reference interpreter: runs one controller of a validated IR per
-//! SEMANTICS.md, cycle by cycle, with its inputs, hook results and
+//! docs/semantics.md, cycle by cycle, with its inputs, hook results and
 //! subordinates' statuses supplied from outside (a scenario, a test).
 //!
 //! New-command detection, the handshake view, the counters and finishing
@@ -245,7 +245,7 @@ impl<'ir> Interpreter<'ir> {
         &self.writes
     }
 
-    /// One control cycle (SEMANTICS.md steps 1–6).
+    /// One control cycle (docs/semantics.md steps 1–6).
     pub fn cycle(&mut self, hooks: &mut dyn Hooks) -> CycleRecord {
         // 1–2. Read; the handshake view of each subordinate.
         for s in &mut self.subs {

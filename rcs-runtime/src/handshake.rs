@@ -1,5 +1,5 @@
 //! Command and status buffers and the supervisor/subordinate handshake
-//! (§5.5 of the methodology; SEMANTICS.md "Buffers" and step 2).
+//! (§5.5 of the methodology; docs/semantics.md "Global Memory and its buffers" and step 2).
 //!
 //! A supervisor commands a subordinate by writing its command buffer with a
 //! fresh serial number; the subordinate echoes the serial of the command it

@@ -4,7 +4,7 @@
 //! template and main program template of the NIST RCS methodology (§3.8,
 //! §5.3–5.5, Appendices A–B) rebuilt for Rust. Generated controllers, the
 //! plan interpreter and hand-written modules (simulators, sensor drivers,
-//! operator interfaces) all run on it. `SEMANTICS.md` of the project is the
+//! operator interfaces) all run on it. `docs/semantics.md` is the
 //! normative description of a cycle; this crate implements its runtime part
 //! once.
 //!

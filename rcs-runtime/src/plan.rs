@@ -1,4 +1,4 @@
-//! Plan bookkeeping: SEMANTICS.md steps 2–4 (all but evaluating rows) and 6,
+//! Plan bookkeeping: docs/semantics.md steps 2–4 (all but evaluating rows) and 6,
 //! implemented once for generated controllers and the interpreter alike.
 //!
 //! A [`Bookkeeping`] holds what the seed's controller template keeps in its

@@ -1,4 +1,4 @@
-//! SEMANTICS.md rules checked through the runtime: Global Memory, the
+//! docs/semantics.md rules checked through the runtime: Global Memory, the
 //! handshake, the bookkeeping and the executive together.
 
 mod common;

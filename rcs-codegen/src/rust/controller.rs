@@ -1,6 +1,6 @@
 //! One controller → one Rust module: its command enum, status and error
 //! enums, a state enum per plan, the `Hooks` trait, the `Data` it works on
-//! and `Controller`, whose `cycle` is SEMANTICS.md's six steps with the
+//! and `Controller`, whose `cycle` is docs/semantics.md's six steps with the
 //! rows compiled to a dispatch on the state.
 
 use super::expr::{rust_type, zero, CachedCall, Code, Gen};
@@ -395,7 +395,7 @@ pub(crate) fn module(
     };
 
     let verb_count_lit = proc_macro2::Literal::usize_unsuffixed(verb_count);
-    // The six steps of a cycle (SEMANTICS.md), as comments in the output.
+    // The six steps of a cycle (docs/semantics.md), as comments in the output.
     let step1 = comments.marker(
         "1. Read: the command, every read buffer and every subordinate's status, once.".to_string(),
     );

@@ -253,8 +253,8 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
 
 /// The text of `System`'s rustdoc example, one line a `#[doc]`: build with
 /// hooks by name, feed the inputs, command the root, run cycles, read an
-/// output and each controller's state by name (docs/using-generated-code.md
-/// walks through the same steps and is tested).
+/// output and each controller's state by name (the README's "Using the
+/// generated code" walks through the same steps and is tested).
 fn system_example(ir: &Ir, names: &Names) -> Vec<String> {
     let system = crate::ident::snake(&ir.system);
     let mut lines = vec![format!("rcs_runtime::include_plans!({:?});", ir.system)];

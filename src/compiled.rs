@@ -124,7 +124,9 @@ pub fn build(irs: &[&Ir], target_dir: &Path, status: &dyn Fn(&str)) -> Result<Dr
     let root = target_dir.join("rcsc");
     let source = root.join("driver");
     let build_dir = root.join("driver-target");
-    let report = rcs_codegen::writer::write_tree(&source, &crate_files(irs))
+    let mut files = crate_files(irs);
+    rcs_codegen::rustfmt::format_files(&mut files);
+    let report = rcs_codegen::writer::write_tree(&source, &files)
         .map_err(|e| format!("writing the scenario driver: {e}"))?;
     let lock = source.join("Cargo.lock");
     if !lock.exists() {

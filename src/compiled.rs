@@ -167,7 +167,9 @@ pub fn build(irs: &[&Ir], target_dir: &Path, status: &dyn Fn(&str)) -> Result<Dr
     let source = root.join("driver");
     let build_dir = root.join("driver-target");
     let runtime = runtime_dependency(&root)?;
-    let report = rcs_codegen::writer::write_tree(&source, &crate_files(irs, &runtime))
+    let mut files = crate_files(irs, &runtime);
+    rcs_codegen::rustfmt::format_files(&mut files);
+    let report = rcs_codegen::writer::write_tree(&source, &files)
         .map_err(|e| format!("writing the scenario driver: {e}"))?;
     let lock = source.join("Cargo.lock");
     if !lock.exists() {

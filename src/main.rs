@@ -141,6 +141,8 @@ DIR (one plan set) or DIR/<system> (several):
   graphs/hierarchy.dot        the controller tree
   tables/<CTRL>.md            the state tables
 
+The Rust is formatted with rustfmt (`$RUSTFMT`, else `rustfmt` on PATH)
+when it runs, else written as rcsc prints it; `--no-rustfmt` skips it.
 Files are rewritten only when their content changed; generated files under
 DIR that are no longer produced are removed (other files are left alone).
 
@@ -170,6 +172,9 @@ struct BuildArgs {
         default_value = "target/rcs"
     )]
     out_dir: PathBuf,
+    /// Write the Rust as rcsc prints it, without running rustfmt on it.
+    #[arg(long)]
+    no_rustfmt: bool,
     #[command(flatten)]
     common: Common,
 }
@@ -599,10 +604,13 @@ fn build(args: BuildArgs) -> ExitCode {
         Err(code) => return code,
     };
 
-    let files = match output_files(&sets, &irs) {
+    let mut files = match output_files(&sets, &irs) {
         Ok(files) => files,
         Err(reason) => return fail(reason),
     };
+    if !args.no_rustfmt {
+        rcs_codegen::rustfmt::format_files(&mut files);
+    }
     let report = match rcs_codegen::writer::write_tree(&args.out_dir, &files) {
         Ok(report) => report,
         Err(e) => return fail(e),

@@ -4,7 +4,7 @@
 use std::process::Command;
 
 mod common;
-mod graphviz;
+mod tools;
 use common::{rcsc, scratch, text};
 
 const BROKEN: &str = "controller A {\n    command GO\n    plan GO {\n        *0 when new_command && nope -> Done\n    }\n}\n";
@@ -73,7 +73,7 @@ fn graph_writes_to_a_file_with_out() {
 
 #[test]
 fn graph_renders_svg_through_graphviz() {
-    if !graphviz::dot_available("`rcsc graph --format svg`") {
+    if !tools::dot_available("`rcsc graph --format svg`") {
         return;
     }
     let out = rcsc(&[

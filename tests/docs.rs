@@ -20,7 +20,7 @@ use rcs_dsl::{Code, Options};
 use std::collections::BTreeSet;
 use std::process::Command;
 
-mod graphviz;
+mod tools;
 
 /// One fenced block: its info string words, its text and its first line.
 struct Block {
@@ -299,7 +299,7 @@ fn normalise_svg(svg: &str) -> String {
 
 #[test]
 fn the_readme_state_graph_is_up_to_date() {
-    if !graphviz::dot_available("docs/ahead.svg") {
+    if !tools::dot_available("docs/ahead.svg") {
         return;
     }
     let out = Command::new(env!("CARGO_BIN_EXE_rcsc"))

@@ -6,16 +6,20 @@
 //!   case and the output path (`tests/snapshots/` for `plans/`,
 //!   `tests/data/ok/snapshots/` for the ok cases); after a deliberate
 //!   change, run `INSTA_UPDATE=always cargo test --test generated` and
-//!   review the diff;
-//! - every DOT file parses with Graphviz (`dot -Tsvg`). Without `dot` the
-//!   test is skipped with a note, unless `CI` is set, where it fails.
+//!   review the diff. The Rust is snapshotted as written, after rustfmt;
+//!   without rustfmt its snapshots are skipped with a note;
+//! - every DOT file parses with Graphviz (`dot -Tsvg`);
+//! - every Rust file `rcsc build` writes passes `rustfmt --check`.
+//!
+//! Without `dot` or `rustfmt` the tests that need them are skipped with a
+//! note, unless `CI` is set, where they fail.
 
 use rcs_codegen::OutputFile;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-mod graphviz;
+mod tools;
 
 /// One plan set to generate: where its snapshots go and its name there.
 struct Case {
@@ -75,8 +79,12 @@ fn generate(case: &Case) -> Vec<OutputFile> {
 
 #[test]
 fn generated_files_match_their_snapshots() {
+    let formatted = tools::rustfmt_available("the snapshots of the generated Rust");
     for case in cases() {
-        let files = generate(&case);
+        let mut files = generate(&case);
+        if formatted {
+            rcs_codegen::rustfmt::format_files(&mut files);
+        }
         let mut paths: Vec<&str> = files.iter().map(|f| f.path.as_str()).collect();
         paths.sort_unstable();
         paths.dedup();
@@ -92,7 +100,7 @@ fn generated_files_match_their_snapshots() {
             omit_expression => true,
             description => format!("{}: rcsc build {}", case.name, case.path.display()),
         }, {
-            for f in &files {
+            for f in files.iter().filter(|f| formatted || !f.path.ends_with(".rs")) {
                 assert!(f.contents.lines().next().unwrap_or("").contains(rcs_codegen::GENERATED));
                 let name = format!("{}__{}", case.name, f.path.replace('/', "__"));
                 insta::assert_snapshot!(name, f.contents);
@@ -103,7 +111,7 @@ fn generated_files_match_their_snapshots() {
 
 #[test]
 fn every_dot_file_renders_with_graphviz() {
-    if !graphviz::dot_available("the generated DOT files") {
+    if !tools::dot_available("the generated DOT files") {
         return;
     }
     let (mut checked, mut failures) = (0, Vec::new());
@@ -145,4 +153,45 @@ fn every_dot_file_renders_with_graphviz() {
         failures.join("\n\n")
     );
     assert!(checked > 10, "only {checked} DOT files");
+}
+
+#[test]
+fn every_rust_file_rcsc_writes_passes_rustfmt_check() {
+    if !tools::rustfmt_available("`rustfmt --check` of the generated Rust") {
+        return;
+    }
+    let out = std::env::temp_dir().join(format!("rcsc-generated-rustfmt-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let mut rust = Vec::new();
+    for case in cases() {
+        let dir = out.join(&case.name);
+        let o = Command::new(env!("CARGO_BIN_EXE_rcsc"))
+            .arg("build")
+            .arg(&case.path)
+            .arg("-o")
+            .arg(&dir)
+            .arg("-q")
+            .output()
+            .expect("rcsc runs");
+        assert!(o.status.success(), "{}: {o:?}", case.name);
+        rust.extend(
+            generate(&case)
+                .into_iter()
+                .filter(|f| f.path.ends_with(".rs"))
+                .map(|f| dir.join(f.path)),
+        );
+    }
+    assert!(rust.len() > 10, "only {} Rust files", rust.len());
+    let o = Command::new(rcs_codegen::rustfmt::program())
+        .args(["--edition", "2021", "--check"])
+        .args(&rust)
+        .output()
+        .expect("rustfmt runs");
+    assert!(
+        o.status.success(),
+        "rustfmt --check finds differences:\n{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let _ = std::fs::remove_dir_all(&out);
 }

@@ -45,6 +45,7 @@ pub struct Config {
     manifest_dir: Option<PathBuf>,
     lints: Vec<(Lint, Level)>,
     graphs: bool,
+    rustfmt: bool,
     options: crate::Options,
 }
 
@@ -104,13 +105,14 @@ impl Default for Config {
 impl Config {
     /// The defaults: output into `$OUT_DIR/rcs`, paths relative to
     /// `$CARGO_MANIFEST_DIR`, lint levels from the plan set, graphs and
-    /// tables included.
+    /// tables included, the Rust formatted by rustfmt when it is installed.
     pub fn new() -> Config {
         Config {
             out_dir: None,
             manifest_dir: None,
             lints: Vec::new(),
             graphs: true,
+            rustfmt: true,
             options: crate::Options::default(),
         }
     }
@@ -157,6 +159,16 @@ impl Config {
     /// besides the Rust code (default: yes).
     pub fn graphs(&mut self, yes: bool) -> &mut Config {
         self.graphs = yes;
+        self
+    }
+
+    /// Whether to format the generated Rust with the `rustfmt` binary
+    /// (default: yes): `$RUSTFMT` if set, else `rustfmt` on `PATH`. When it
+    /// is missing, fails or hangs (killed after a minute), the code is
+    /// written as rcsc prints it, which compiles the same; formatting never
+    /// fails the build. See [`crate::rustfmt`].
+    pub fn rustfmt(&mut self, yes: bool) -> &mut Config {
+        self.rustfmt = yes;
         self
     }
 
@@ -225,7 +237,10 @@ impl Config {
 
         let irs: Vec<&rcs_dsl::ir::Ir> = irs.iter().collect();
         let shared = rcs_dsl::load::shares_output(&sets);
-        let files = crate::generate_sets(&irs, shared, &self.options, self.graphs)?;
+        let mut files = crate::generate_sets(&irs, shared, &self.options, self.graphs)?;
+        if self.rustfmt {
+            crate::rustfmt::format_files(&mut files);
+        }
         let out_dir = match &self.out_dir {
             Some(d) => d.clone(),
             None => PathBuf::from(env("OUT_DIR", "out_dir")?).join("rcs"),
@@ -585,6 +600,45 @@ mod tests {
             err.to_string(),
             "could not compile the plans in `plans` due to 2 errors"
         );
+    }
+
+    #[test]
+    fn the_rust_is_formatted_by_rustfmt_unless_turned_off() {
+        let dir = scratch("rustfmt", &[("a.rcs", GO)]);
+        let read =
+            |out: &str, file: &str| std::fs::read_to_string(dir.join(out).join(file)).unwrap();
+        let config = |out: &str| {
+            Config::new()
+                .manifest_dir(&dir)
+                .out_dir(dir.join(out))
+                .clone()
+        };
+        let mut sink = Vec::new();
+        config("on")
+            .compile_with_io(Path::new("plans"), &mut sink, &mut Vec::new())
+            .unwrap();
+        config("off")
+            .rustfmt(false)
+            .compile_with_io(Path::new("plans"), &mut sink, &mut Vec::new())
+            .unwrap();
+        let (on, off) = (read("on", "rust/plans.rs"), read("off", "rust/plans.rs"));
+        let program = crate::rustfmt::program();
+        let timeout = crate::rustfmt::TIMEOUT;
+        match crate::rustfmt::format_source(&program, timeout, &off) {
+            Some(formatted) => {
+                assert_eq!(on, formatted);
+                assert_ne!(on, off, "prettyplease and rustfmt differ here");
+                // include.rs is written rustfmt-clean.
+                let include = read("on", INCLUDE_FILE);
+                assert_eq!(
+                    crate::rustfmt::format_source(&program, timeout, &include).as_deref(),
+                    Some(include.as_str())
+                );
+            }
+            None => assert_eq!(on, off, "no rustfmt: written as printed"),
+        }
+        assert_eq!(read("on", "tables/A.md"), read("off", "tables/A.md"));
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

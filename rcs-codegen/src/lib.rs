@@ -8,11 +8,15 @@
 //!    ──dot───▶ graphs/<CTRL>/<VERB>.dot, graphs/hierarchy.dot
 //!    ──table─▶ tables/<CTRL>.md
 //! ```
+//!
+//! Between generation and the writer, [`rustfmt`] formats the Rust files
+//! with the installed `rustfmt` (when there is one).
 
 pub mod config;
 pub mod dot;
 pub mod ident;
 pub mod rust;
+pub mod rustfmt;
 pub mod table;
 pub mod writer;
 

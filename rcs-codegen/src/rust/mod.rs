@@ -1,6 +1,8 @@
 //! IR → one Rust module for the whole plan set: `quote` builds the tokens,
 //! `syn` checks they form a file, `prettyplease` prints them, and the row
 //! comments (which tokens cannot carry) are put back in at their markers.
+//! The writers then pass the text through rustfmt when it is installed
+//! ([`crate::rustfmt`]); this module stays a pure function of the IR.
 
 mod controller;
 mod driver;

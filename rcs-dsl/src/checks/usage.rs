@@ -172,7 +172,11 @@ pub(crate) fn check_unused(ir: &Ir, sink: &mut Sink) {
                 );
             }
         }
-        for b in c.reads.iter().chain(&c.writes) {
+        // Hooks see every `reads` buffer through `Data`: with hooks, an
+        // unread buffer may be theirs, so only a controller without hooks
+        // is told its `reads` buffer is unused.
+        let unread = c.reads.iter().filter(|_| c.hooks.is_empty());
+        for b in unread.chain(&c.writes) {
             if !buffer_used[b.index()] {
                 let name = &ir.buffers[b.index()].name;
                 report(

@@ -440,6 +440,19 @@ impl Cx<'_, '_> {
                 let f = *v as f64;
                 e.kind = ExprKind::Float(f);
             }
+            // An `f64` literal that is finite but beyond `f32` (`1e300`)
+            // would become infinity; refuse it as `1e400` is refused.
+            (ExprKind::Float(v), Type::Float(FloatTy::F32)) if (*v as f32).is_infinite() => {
+                let v = *v;
+                self.mismatch(
+                    e.span,
+                    format!(
+                        "literal `{}` does not fit in `f32`",
+                        crate::pretty::float(v)
+                    ),
+                    format!("`f32` holds at most {:e} in magnitude", f32::MAX),
+                );
+            }
             (ExprKind::Unary(UnOp::Neg, inner), _) => self.fix_literals(inner, ty),
             (ExprKind::Binary(op, l, r), _) if is_arith(*op) => {
                 self.fix_literals(l, ty);
@@ -1231,10 +1244,13 @@ impl Cx<'_, '_> {
                         t,
                     )
                 } else {
-                    // A comparison of two literals: give them their defaults.
-                    let settled = self.settle(&mut a, &t);
-                    if let Ty::Known(k) = &settled {
-                        self.fix_literals(&mut b, k);
+                    // A comparison of two literals: give them their defaults
+                    // (with a known type, both sides were settled above).
+                    if matches!(t, Ty::IntLit | Ty::FloatLit) {
+                        let settled = self.settle(&mut a, &t);
+                        if let Ty::Known(k) = &settled {
+                            self.fix_literals(&mut b, k);
+                        }
                     }
                     (
                         Expr {

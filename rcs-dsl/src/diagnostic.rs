@@ -140,6 +140,9 @@ impl Code {
             Code::Lint(Lint::LevelOrder) => "a subordinate's level is not below its supervisor's",
             Code::Lint(Lint::FloatEquality) => "floats compared with `==` or `!=`",
             Code::Lint(Lint::Unused) => "a declaration is never used",
+            Code::Lint(Lint::UnhandledError) => {
+                "a state waits for a subordinate that can fail, and nothing handles the failure"
+            }
         }
     }
 
@@ -169,6 +172,23 @@ pub struct Diagnostic {
     pub labels: Vec<Label>,
     pub notes: Vec<String>,
     pub help: Option<String>,
+    /// For a finding that something can happen: the concrete inputs of one
+    /// cycle that make it happen (also shown as a note).
+    pub witness: Option<Witness>,
+}
+
+/// The inputs of one cycle that make a finding happen, as the language
+/// writes them, in the state it happens in.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Witness {
+    pub state: String,
+    pub inputs: Vec<WitnessInput>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct WitnessInput {
+    pub name: String,
+    pub value: String,
 }
 
 impl Diagnostic {
@@ -190,6 +210,7 @@ impl Diagnostic {
             }],
             notes: Vec::new(),
             help: None,
+            witness: None,
         }
     }
 
@@ -216,6 +237,26 @@ impl Diagnostic {
 
     pub fn with_note(mut self, note: impl Into<String>) -> Self {
         self.notes.push(note.into());
+        self
+    }
+
+    /// The witness of a "can happen" finding, also as a `for example:` note.
+    pub fn with_witness(mut self, state: &str, inputs: &[(String, String)]) -> Self {
+        let shown: Vec<String> = inputs.iter().map(|(n, v)| format!("{n} = {v}")).collect();
+        self.notes.push(format!(
+            "for example, in state {state}: {}",
+            shown.join(", ")
+        ));
+        self.witness = Some(Witness {
+            state: state.to_string(),
+            inputs: inputs
+                .iter()
+                .map(|(name, value)| WitnessInput {
+                    name: name.clone(),
+                    value: value.clone(),
+                })
+                .collect(),
+        });
         self
     }
 

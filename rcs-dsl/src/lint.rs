@@ -18,10 +18,11 @@ pub enum Lint {
     LevelOrder,
     FloatEquality,
     Unused,
+    UnhandledError,
 }
 
 impl Lint {
-    pub const ALL: [Lint; 9] = [
+    pub const ALL: [Lint; 10] = [
         Lint::RuleOfTen,
         Lint::ShadowedRow,
         Lint::UnreachableState,
@@ -31,6 +32,7 @@ impl Lint {
         Lint::LevelOrder,
         Lint::FloatEquality,
         Lint::Unused,
+        Lint::UnhandledError,
     ];
 
     pub fn name(self) -> &'static str {
@@ -44,6 +46,7 @@ impl Lint {
             Lint::LevelOrder => "level_order",
             Lint::FloatEquality => "float_equality",
             Lint::Unused => "unused",
+            Lint::UnhandledError => "unhandled_error",
         }
     }
 
@@ -92,7 +95,7 @@ pub type LintOverride = (Lint, Level);
 /// The lint levels in force for a whole plan set before attributes apply.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct LintLevels {
-    levels: [Level; 9],
+    levels: [Level; Lint::ALL.len()],
 }
 
 impl Default for LintLevels {

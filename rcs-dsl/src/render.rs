@@ -166,6 +166,9 @@ pub struct JsonDiagnostic {
     pub labels: Vec<JsonLabel>,
     pub notes: Vec<String>,
     pub help: Option<String>,
+    /// The witness of a "can happen" finding: `{state, inputs: [{name, value}]}`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub witness: Option<crate::diagnostic::Witness>,
 }
 
 fn position(sources: &SourceMap, span: Span) -> (String, usize, usize, usize, usize) {
@@ -205,5 +208,6 @@ pub fn json(d: &Diagnostic, sources: &SourceMap) -> JsonDiagnostic {
             .collect(),
         notes: d.notes.clone(),
         help: d.help.clone(),
+        witness: d.witness.clone(),
     }
 }

@@ -98,6 +98,8 @@ pub fn system_module(ir: &Ir, options: &crate::Options) -> String {
             // Conditions are the plan's own, verbatim: redundant or duplicated
             // logic in a plan is the plan's (rcsc's checks report what matters,
             // e.g. `shadowed_row`) and must not fail the user's clippy run.
+            // `System` has one type parameter per controller with hooks, so
+            // its types grow with the plan set (`type_complexity`).
             #![allow(
                 unused_comparisons,
                 clippy::nonminimal_bool,
@@ -110,7 +112,8 @@ pub fn system_module(ir: &Ir, options: &crate::Options) -> String {
                 clippy::erasing_op,
                 clippy::absurd_extreme_comparisons,
                 clippy::manual_range_contains,
-                clippy::approx_constant
+                clippy::approx_constant,
+                clippy::type_complexity
             )]
             use ::rcs_runtime as rt;
             #types

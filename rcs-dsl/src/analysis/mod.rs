@@ -44,7 +44,7 @@ pub mod eval;
 pub mod search;
 pub mod terms;
 
-use crate::ir::{Condition, Controller, From, Ir, Plan, StateId, Type};
+use crate::ir::{Condition, Controller, CtrlId, From, Ir, Plan, StateId, StatusId, Type};
 use rcs_runtime::driver::Value;
 use search::{Mode, Outcome, Search};
 use std::rc::Rc;
@@ -167,6 +167,36 @@ impl<'ir> PlanAnalysis<'ir> {
     pub fn can_fire_while(&self, row: usize, other: usize, state: StateId) -> Answer {
         let (f, fixed, state) = self.question(Question::FiresWhile(row, other, state));
         self.decide(&f, &fixed, state)
+    }
+
+    /// Whether, in `state`, no row can match while subordinate `sub` shows
+    /// `status`, whatever every other input is: the plan then stays in
+    /// `state` until a new command. `Some` carries one such cycle's inputs;
+    /// `None` when some row may match (or the analysis cannot tell, or no
+    /// condition reads `sub`'s status).
+    pub fn stalls_in(&self, state: StateId, sub: CtrlId, status: StatusId) -> Option<Witness> {
+        let leaf = self.terms.find(&Leaf::SubStatus(sub))?;
+        let mut any = Vec::new();
+        for (i, row) in self.plan.rows.iter().enumerate() {
+            if covers(&row.from, state) {
+                // An `otherwise` row matches when nothing else does.
+                any.push(Formula::Shared(self.conds[i].clone()?));
+            }
+        }
+        let mut fixed = self.fixed(state);
+        fixed.push((leaf, Value::Status(status.0 as u16)));
+        let some_row = Formula::Or(any);
+        if !matches!(self.prove(&some_row, &fixed), Outcome::None) {
+            return None;
+        }
+        let none = Formula::Not(Box::new(some_row));
+        let candidates = self
+            .candidates
+            .get_or_init(|| domain::candidates(self.ir, &self.terms, &self.cells));
+        match Search::new(&self.terms, Mode::Witness, candidates, &[], &fixed).run(&none) {
+            Outcome::Found(values) => Some(self.witness(&none, state, values)),
+            Outcome::None | Outcome::Unknown => None,
+        }
     }
 
     /// [`can_match`](Self::can_match) is [`Answer::Never`], without looking

@@ -4,10 +4,12 @@
 //! force at their place (manifest, flags, then attributes).
 
 mod graph;
+mod handshake;
 mod hierarchy;
 mod plan;
 mod usage;
 
+use crate::analysis::PlanAnalysis;
 use crate::diagnostic::{Diagnostic, Diagnostics};
 use crate::ir::{Controller, Ir, Plan};
 use crate::lint::{Lint, LintLevels};
@@ -84,22 +86,48 @@ pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagno
     let start = diags.len();
     let mut sink = Sink { levels, diags };
     plan::check_missing_plans(ir, &mut sink);
-    for c in &ir.controllers {
-        for p in &c.plans {
+    // The analysis of every plan's conditions and its graph first: the
+    // checks of a plan ask its own, the handshake checks their
+    // subordinates'.
+    let conditions: Vec<Vec<PlanAnalysis>> = ir
+        .controllers
+        .iter()
+        .map(|c| {
+            c.plans
+                .iter()
+                .map(|p| PlanAnalysis::new(ir, c, p))
+                .collect()
+        })
+        .collect();
+    let graphs: Vec<Vec<graph::Analysis>> = ir
+        .controllers
+        .iter()
+        .zip(&conditions)
+        .map(|(c, cs)| {
+            c.plans
+                .iter()
+                .zip(cs)
+                .map(|(p, a)| graph::analyse(p, a))
+                .collect()
+        })
+        .collect();
+    for (ci, c) in ir.controllers.iter().enumerate() {
+        for (pi, p) in c.plans.iter().enumerate() {
+            let (conditions, analysis) = (&conditions[ci][pi], &graphs[ci][pi]);
             plan::check_row_numbers(c, p, &mut sink);
             plan::check_otherwise(p, &mut sink);
             plan::check_entry(p, &mut sink);
             plan::check_double_commands(ir, p, &mut sink);
             plan::check_rule_of_ten(ir, c, p, &mut sink);
-            let conditions = crate::analysis::PlanAnalysis::new(ir, c, p);
-            let analysis = graph::analyse(p, &conditions);
-            plan::check_unreachable_rows(p, &analysis, &mut sink);
-            plan::check_shadowed_rows(c, p, &analysis, &conditions, &mut sink);
-            graph::check_unreachable_states(c, p, &analysis, &mut sink);
-            graph::check_dead_ends(c, p, &analysis, &mut sink);
-            graph::check_no_done(ir, c, p, &analysis, &mut sink);
+            plan::check_unreachable_rows(p, analysis, &mut sink);
+            plan::check_shadowed_rows(c, p, analysis, conditions, &mut sink);
+            graph::check_unreachable_states(c, p, analysis, &mut sink);
+            graph::check_dead_ends(c, p, analysis, &mut sink);
+            graph::check_no_done(ir, c, p, analysis, &mut sink);
         }
     }
+    let plans = handshake::Plans { conditions, graphs };
+    handshake::check_unhandled_error(ir, &plans, &mut sink);
     hierarchy::check_span_of_control(ir, &mut sink);
     hierarchy::check_level_order(ir, &mut sink);
     usage::check_float_equality(ir, &mut sink);

@@ -1,0 +1,140 @@
+//! Checks across a supervisor and its subordinates, through the handshake:
+//! `unhandled_error` — a state that waits for `X.done` where nothing can
+//! fire once X reports `ERROR`, although the plan X runs for it can end in
+//! `Error`. Each finding is proved by the analysis of conditions and
+//! carries a witness: a cycle, with `X.status = ERROR`, in which no row of
+//! that state matches.
+
+use super::graph::Analysis;
+use super::Sink;
+use crate::analysis::{covers, PlanAnalysis};
+use crate::ast::BinOp;
+use crate::diagnostic::Diagnostic;
+use crate::ir::{
+    CommandId, CtrlId, Expr, ExprKind, From, Ir, Job, Row, StateId, StatusId, SubProp, Target,
+};
+use crate::lint::Lint;
+
+/// Per controller, per plan: the analysis of its conditions and its graph.
+pub(crate) struct Plans<'a> {
+    pub conditions: Vec<Vec<PlanAnalysis<'a>>>,
+    pub graphs: Vec<Vec<Analysis>>,
+}
+
+pub(crate) fn check_unhandled_error(ir: &Ir, plans: &Plans, sink: &mut Sink) {
+    for (ci, c) in ir.controllers.iter().enumerate() {
+        for (pi, p) in c.plans.iter().enumerate() {
+            let conditions = &plans.conditions[ci][pi];
+            let graph = &plans.graphs[ci][pi];
+            for &x in &c.subordinates {
+                // The verbs this plan sends X, and a row of X's plans for
+                // them that can end in Error.
+                let sent = verbs_sent(&p.rows, x);
+                let Some(fails) = sent.iter().find_map(|v| error_row(ir, plans, x, *v)) else {
+                    continue;
+                };
+                for s in (0..p.states.len()).filter(|s| graph.reachable[*s]) {
+                    let state = StateId(s as u32);
+                    let waiting: Vec<&Row> = p
+                        .rows
+                        .iter()
+                        .filter(|r| covers(&r.from, state) && waits_for_done(r, x))
+                        .filter(|r| !conditions.never_fires_in(r.position as usize, state))
+                        .collect();
+                    let Some(first) = waiting.first() else {
+                        continue;
+                    };
+                    let Some(w) = conditions.stalls_in(state, x, StatusId::ERROR) else {
+                        continue;
+                    };
+                    let sub = &ir.controller(x).name;
+                    let state_name = &p.states[s].name;
+                    let verb = &c.commands[p.verb.index()].name;
+                    let (xp, xr) = fails;
+                    let x_ctrl = ir.controller(x);
+                    let x_verb = &x_ctrl.commands[x_ctrl.plans[xp].verb.index()].name;
+                    let x_row = &x_ctrl.plans[xp].rows[xr];
+                    let d = Diagnostic::lint(
+                        Lint::UnhandledError,
+                        format!(
+                            "state `{state_name}` of plan `{verb}` waits for `{sub}.done`, \
+                             but nothing handles `{sub}.error`"
+                        ),
+                        first.cond_span,
+                        format!("waits for `{sub}.done`"),
+                    )
+                    .with_secondary(
+                        x_row.span,
+                        format!("`{sub}`'s plan `{x_verb}` can end in `Error` here"),
+                    )
+                    .with_witness(state_name, &w.shown)
+                    .with_note(format!(
+                        "with `{sub}.status == ERROR` no row of `{state_name}` matches, whatever \
+                         the other inputs: `{}` stays in `{state_name}` until a new command",
+                        c.name
+                    ))
+                    .with_help(format!(
+                        "handle the failure: a row such as `*N when {sub}.error -> Error(CODE)`, \
+                         or a timeout (`{state_name} when state_cycles > N -> …`)"
+                    ));
+                    sink.lint(Some(c), Some(p), d);
+                }
+            }
+        }
+    }
+}
+
+/// The verbs `rows` send to subordinate `x`, in order, without repeats.
+fn verbs_sent(rows: &[Row], x: CtrlId) -> Vec<CommandId> {
+    let mut verbs = Vec::new();
+    for r in rows {
+        for j in &r.jobs {
+            if let Job::Send { sub, command, .. } = j {
+                if *sub == x && !verbs.contains(command) {
+                    verbs.push(*command);
+                }
+            }
+        }
+    }
+    verbs
+}
+
+/// A row of `x`'s plan for `verb` that ends in `Error` and that the
+/// analysis cannot rule out: (plan index, row index).
+fn error_row(ir: &Ir, plans: &Plans, x: CtrlId, verb: CommandId) -> Option<(usize, usize)> {
+    let pid = ir.controller(x).commands[verb.index()].plan?.index();
+    let plan = &ir.controller(x).plans[pid];
+    let graph = &plans.graphs[x.index()][pid];
+    plan.rows
+        .iter()
+        .position(|r| {
+            matches!(r.to, Target::Error(_))
+                && !graph.never_matches[r.position as usize]
+                && match r.from {
+                    From::State(s) => graph.reachable[s.index()],
+                    From::DontCare(_) => true,
+                }
+        })
+        .map(|r| (pid, r))
+}
+
+/// Whether a row's condition tests `x.done` (or `x.status == DONE`).
+fn waits_for_done(r: &Row, x: CtrlId) -> bool {
+    let mut found = false;
+    if let crate::ir::Condition::When(e) = &r.cond {
+        e.visit(&mut |e| found |= is_done_test(e, x));
+    }
+    found
+}
+
+fn is_done_test(e: &Expr, x: CtrlId) -> bool {
+    let status_of_x = |e: &Expr| matches!(e.kind, ExprKind::Sub(c, SubProp::Status) if c == x);
+    let done = |e: &Expr| matches!(e.kind, ExprKind::Status(s) if s == StatusId::DONE);
+    match &e.kind {
+        ExprKind::Sub(c, SubProp::Done) => *c == x,
+        ExprKind::Binary(BinOp::Eq, l, r) => {
+            (status_of_x(l) && done(r)) || (done(l) && status_of_x(r))
+        }
+        _ => false,
+    }
+}

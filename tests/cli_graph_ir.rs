@@ -219,8 +219,8 @@ fn ir_json_parses_back() {
         .as_array()
         .unwrap()
         .iter()
-        .find(|p| p["rows"].as_array().unwrap().len() == 6)
-        .expect("the AHEAD plan has six rows");
+        .find(|p| p["rows"].as_array().unwrap().len() == 7)
+        .expect("the AHEAD plan has seven rows");
     assert_eq!(ahead["states"][0]["name"], "S0");
     assert_eq!(ahead["rows"][0]["is_entry"], true);
     // Spans are byte ranges into a file of the set, named relative to it.

@@ -20,65 +20,11 @@ use rcs_dsl::{Code, Options};
 use std::collections::BTreeSet;
 use std::process::Command;
 
+mod markdown;
 mod tools;
+mod walkthrough;
 
-/// One fenced block: its info string words, its text and its first line.
-struct Block {
-    lang: String,
-    attrs: Vec<String>,
-    text: String,
-    line: usize,
-}
-
-fn blocks(markdown: &str) -> Vec<Block> {
-    let mut out = Vec::new();
-    let mut current: Option<Block> = None;
-    for (i, line) in markdown.lines().enumerate() {
-        let trimmed = line.trim_start();
-        match current.take() {
-            None => {
-                if let Some(info) = trimmed.strip_prefix("```") {
-                    let mut words = info.split_whitespace().map(str::to_string);
-                    current = Some(Block {
-                        lang: words.next().unwrap_or_default(),
-                        attrs: words.collect(),
-                        text: String::new(),
-                        line: i + 2,
-                    });
-                }
-            }
-            Some(mut b) => {
-                if trimmed.starts_with("```") {
-                    out.push(b);
-                } else {
-                    b.text.push_str(line);
-                    b.text.push('\n');
-                    current = Some(b);
-                }
-            }
-        }
-    }
-    assert!(current.is_none(), "an unclosed ``` block");
-    out
-}
-
-impl Block {
-    /// `expect=a,b` (also `expect=a, b` split over words), if given.
-    fn expected(&self) -> Option<BTreeSet<String>> {
-        let joined = self.attrs.join(" ");
-        let rest = joined.split_once("expect=")?.1;
-        Some(
-            rest.split(',')
-                .map(|s| s.trim().to_string())
-                .filter(|s| !s.is_empty())
-                .collect(),
-        )
-    }
-
-    fn is_fragment(&self) -> bool {
-        self.attrs.iter().any(|a| a == "fragment")
-    }
-}
+use markdown::{blocks, Block};
 
 /// Check one plan set made of `rcs` (as `example.rcs`) and an optional manifest;
 /// returns the codes found and their short rendering.
@@ -334,88 +280,11 @@ fn the_readme_state_graph_is_up_to_date() {
     );
 }
 
-/// The README's "Using the generated code", followed as a newcomer would: its
-/// `file=…` blocks make a crate outside the workspace (`/path/to/rcsc`
-/// becomes this checkout, and `plans/submarine` is copied in as its first
-/// step says), `cargo run` builds and runs it offline against this
-/// checkout's lock file, and its output starts each line of the
-/// ```text output block.
+/// The README's "Using the generated code", followed as a newcomer would,
+/// against this checkout (see `walkthrough`).
 #[test]
 fn using_the_generated_code_works_as_written() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
-    let doc = readme
-        .split("\n## ")
-        .find(|s| s.starts_with("Using the generated code\n"))
-        .expect("README.md has a `## Using the generated code` section");
-    let blocks = blocks(doc);
-    let mut files: Vec<(String, String)> = Vec::new();
-    for b in &blocks {
-        let Some(file) = b.attrs.iter().find_map(|a| a.strip_prefix("file=")) else {
-            continue;
-        };
-        let text = b.text.replace("/path/to/rcsc", &root.display().to_string());
-        match files.iter_mut().find(|(f, _)| f == file) {
-            Some((_, all)) => all.push_str(&text),
-            None => files.push((file.to_string(), text)),
-        }
-    }
-    let names: Vec<&str> = files.iter().map(|(f, _)| f.as_str()).collect();
-    assert_eq!(names, ["Cargo.toml", "build.rs", "src/main.rs"]);
-    let expected: Vec<&str> = blocks
-        .iter()
-        .find(|b| b.lang == "text" && b.attrs.iter().any(|a| a == "output"))
-        .expect("a ```text output block")
-        .text
-        .lines()
-        .collect();
-
-    // Outside the workspace (cargo would take it for a member), one folder
-    // per checkout; the build is cached under this checkout's target/.
-    let tag: String = root
-        .display()
-        .to_string()
-        .chars()
-        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
-        .collect();
-    let dir = std::env::temp_dir().join(format!("rcsc-using-generated-code{tag}"));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(dir.join("src")).unwrap();
-    copy_tree(&root.join("plans/submarine"), &dir.join("plans/submarine"));
-    for (file, text) in &files {
-        std::fs::write(dir.join(file), text).unwrap();
-    }
-    std::fs::copy(root.join("Cargo.lock"), dir.join("Cargo.lock")).unwrap();
-    let out = Command::new(env!("CARGO"))
-        .args(["run", "--quiet", "--offline"])
-        .current_dir(&dir)
-        .env("CARGO_TARGET_DIR", root.join("target/using-generated-code"))
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "the walk-through's crate failed:\n{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let lines: Vec<&str> = stdout.lines().collect();
-    assert_eq!(lines.len(), expected.len(), "output:\n{stdout}");
-    for (got, want) in lines.iter().zip(&expected) {
-        assert!(got.starts_with(want), "`{got}` should start with `{want}`");
-    }
-    std::fs::remove_dir_all(dir).ok();
-}
-
-/// `cp -r from to`.
-fn copy_tree(from: &std::path::Path, to: &std::path::Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for entry in std::fs::read_dir(from).unwrap() {
-        let path = entry.unwrap().path();
-        let dest = to.join(path.file_name().unwrap());
-        if path.is_dir() {
-            copy_tree(&path, &dest);
-        } else {
-            std::fs::copy(&path, dest).unwrap();
-        }
-    }
+    walkthrough::run(&readme, root, &root.join("target/using-generated-code"));
 }

@@ -2,7 +2,8 @@
 //! HEAD, as CI and a newcomer get it: uncommitted changes are not in it),
 //! then the commands of README.md's `## Quick start` `sh` block, read from
 //! the README at test time and run as written in one shell, then the files
-//! the Quick start promises.
+//! the Quick start promises; then the README's "Using the generated code"
+//! against the clone (see `walkthrough`).
 //!
 //! Lines not run: the `git clone …` line (the test made the clone),
 //! comment-only lines, and `cargo test …` — the test suite is what runs
@@ -17,6 +18,8 @@
 
 #[allow(dead_code)] // not every helper is used here
 mod common;
+mod markdown;
+mod walkthrough;
 
 use common::{scratch, text};
 use std::path::Path;
@@ -152,6 +155,15 @@ fn the_readme_quick_start_works_on_a_fresh_clone() {
         "the Quick start promises {missing:?}; stderr:\n{}",
         text(&out.stderr)
     );
+
+    // Then "Using the generated code", as written, against the clone.
+    let started = Instant::now();
+    walkthrough::run(
+        &readme,
+        &clone,
+        &Path::new(env!("CARGO_TARGET_TMPDIR")).join("newcomer-walkthrough"),
+    );
+    eprintln!("Using the generated code: {:.1?}", started.elapsed());
     let _ = std::fs::remove_dir_all(&tmp);
     let _ = std::fs::remove_dir_all(&clone);
 }

@@ -96,7 +96,7 @@ pub struct PlanAnalysis<'ir> {
     terms: Terms,
     /// Per row: its condition (`None` for `otherwise`).
     conds: Vec<Option<Rc<Formula>>>,
-    /// Per row: a representative value of every cell of every leaf.
+    /// Per leaf: a representative value of each of its cells.
     cells: Vec<Vec<Value>>,
     /// Per atom: for an exact one, its truth value on each cell of its leaf.
     tables: Vec<Option<Vec<bool>>>,
@@ -213,6 +213,99 @@ impl<'ir> PlanAnalysis<'ir> {
     /// [`can_fire_while`](Self::can_fire_while) is [`Answer::Never`].
     pub fn never_fires_while(&self, row: usize, other: usize, state: StateId) -> bool {
         self.proves_never(Question::FiresWhile(row, other, state))
+    }
+
+    /// The leaves, by id: what a [`Witness`] and the `given` values of the
+    /// `*_given` questions are made of.
+    pub fn terms(&self) -> &Terms {
+        &self.terms
+    }
+
+    /// One representative value per cell of `leaf`: every comparison in
+    /// the plan has one truth value on all values of a cell, so trying
+    /// these is trying every value.
+    pub fn cell_values(&self, leaf: LeafId) -> &[Value] {
+        &self.cells[leaf]
+    }
+
+    /// The leaves that hold one value for the whole command, whatever it
+    /// is: the command's parameters (a new command starts a new plan run).
+    pub fn command_leaves(&self) -> Vec<LeafId> {
+        (0..self.terms.leaves.len())
+            .filter(|&l| matches!(self.terms.leaves[l].0, Leaf::Param(..)))
+            .collect()
+    }
+
+    /// The vars (and parts of vars) the conditions read that no job of any
+    /// plan of the controller assigns, with the one value they ever hold:
+    /// their initialiser. Hooks see the controller's data read-only, so
+    /// only jobs change vars.
+    pub fn constant_vars(&self) -> Vec<(LeafId, Value)> {
+        let assigned = assigned_vars(self.ctrl);
+        let Some(ctrl) = self
+            .ir
+            .controllers
+            .iter()
+            .position(|c| std::ptr::eq(c, self.ctrl))
+        else {
+            return Vec::new();
+        };
+        let initial = crate::interp::Interpreter::new(self.ir, CtrlId(ctrl as u32));
+        let mut out = Vec::new();
+        for (l, (leaf, _)) in self.terms.leaves.iter().enumerate() {
+            let Leaf::Var(v, steps) = leaf else { continue };
+            if assigned.contains(v) {
+                continue;
+            }
+            let mut value = initial.vars()[v.index()].clone();
+            for s in steps {
+                value = match (s, value) {
+                    (terms::Step::Field(f), Value::Buffer(mut fs)) if (*f as usize) < fs.len() => {
+                        fs.swap_remove(*f as usize)
+                    }
+                    (terms::Step::Index(i), Value::Array(mut xs)) if (*i as usize) < xs.len() => {
+                        xs.swap_remove(*i as usize)
+                    }
+                    _ => Value::Unit,
+                };
+            }
+            if value != Value::Unit {
+                out.push((l, value));
+            }
+        }
+        out
+    }
+
+    /// [`can_fire_in`](Self::can_fire_in) with some leaves pinned to
+    /// values.
+    pub fn can_fire_in_given(
+        &self,
+        row: usize,
+        state: StateId,
+        given: &[(LeafId, Value)],
+    ) -> Answer {
+        let (f, mut fixed, state) = self.question(Question::FiresIn(row, state));
+        fixed.extend(given.iter().cloned());
+        self.decide(&f, &fixed, state)
+    }
+
+    /// Whether no row covering `state` can match, whatever the leaves not
+    /// in `given` are: the plan cannot leave `state` (nor run any job
+    /// there) while the `given` values hold. A proof: `false` when unknown.
+    pub fn nothing_matches_given(&self, state: StateId, given: &[(LeafId, Value)]) -> bool {
+        let mut any = Vec::new();
+        for (i, row) in self.plan.rows.iter().enumerate() {
+            if covers(&row.from, state) {
+                match &self.conds[i] {
+                    Some(c) => any.push(Formula::Shared(c.clone())),
+                    // An `otherwise` row matches when nothing else does.
+                    None => return false,
+                }
+            }
+        }
+        let mut fixed = self.fixed(state);
+        fixed.extend(given.iter().cloned());
+        matches!(self.prove(&Formula::Or(any), &fixed), Outcome::None)
     }
 
     fn proves_never(&self, q: Question) -> bool {
@@ -414,6 +507,25 @@ impl<'ir> PlanAnalysis<'ir> {
             (_, v) => format!("{v:?}"),
         }
     }
+}
+
+/// The vars some job of some plan of `ctrl` assigns.
+fn assigned_vars(ctrl: &Controller) -> Vec<crate::ir::VarId> {
+    let mut vars = Vec::new();
+    for p in &ctrl.plans {
+        for r in &p.rows {
+            for j in &r.jobs {
+                if let crate::ir::Job::Assign { place, .. } = j {
+                    if let crate::ir::PlaceRoot::Var(v) = place.root {
+                        if !vars.contains(&v) {
+                            vars.push(v);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    vars
 }
 
 /// Whether a row's state pattern covers `state`.

@@ -72,8 +72,9 @@ impl<'a> Search<'a> {
         let mut cell = vec![0; terms.leaves.len()];
         for (l, v) in fixed {
             leaves[*l] = Some(v.clone());
-            // A fixed value stands for its cell (fixed leaves are booleans).
-            cell[*l] = domains[*l].iter().position(|d| d == v).unwrap_or(0);
+            if mode == Mode::Prove {
+                cell[*l] = cell_of(terms, tables, domains, *l, v);
+            }
         }
         let find = |l: Leaf| terms.find(&l);
         Search {
@@ -260,6 +261,35 @@ impl<'a> Search<'a> {
         };
         Some(ok)
     }
+}
+
+/// The cell of leaf `l` that value `v` lies in: the one on which every
+/// exact atom of `l` has the truth value it has on `v`.
+fn cell_of(
+    terms: &Terms,
+    tables: &[Option<Vec<bool>>],
+    cells: &[Vec<Value>],
+    l: LeafId,
+    v: &Value,
+) -> usize {
+    if let Some(i) = cells[l].iter().position(|d| d == v) {
+        return i;
+    }
+    let lookup = |leaf: &Leaf| (terms.find(leaf) == Some(l)).then(|| v.clone());
+    let truths: Vec<(usize, bool)> = terms
+        .atoms
+        .iter()
+        .enumerate()
+        .filter(|(_, a)| a.exact && a.leaves == [l])
+        .map(|(i, a)| (i, matches!(eval(&a.expr, &lookup), Some(Value::Bool(true)))))
+        .collect();
+    (0..cells[l].len())
+        .find(|&c| {
+            truths
+                .iter()
+                .all(|&(a, t)| tables[a].as_ref().and_then(|tb| tb.get(c)) == Some(&t))
+        })
+        .unwrap_or(0)
 }
 
 fn and3(a: Option<bool>, b: Option<bool>) -> Option<bool> {

@@ -7,7 +7,9 @@
 //! No cascades: a name that does not resolve is reported once, and the
 //! expression it stood in gets an error type that fits everywhere.
 
+mod declarations;
 mod expr;
+mod plans;
 pub use expr::type_name;
 
 use crate::ast;
@@ -65,7 +67,7 @@ pub fn lower(
     let ctrl_asts = lower_controller_headers(&globals, &mut ir, sources, diags);
     check_hierarchy_cycles(&ir, diags);
     for (i, c) in ctrl_asts.iter().enumerate() {
-        expr::lower_controller_body(&globals, &mut ir, CtrlId(i as u32), c, diags);
+        declarations::lower_controller_body(&globals, &mut ir, CtrlId(i as u32), c, diags);
     }
     ir.schedule = lower_schedule(&ir, manifest, diags);
     for c in &mut ir.controllers {
@@ -568,7 +570,7 @@ fn lower_controller_headers<'a>(
             }
         }
     }
-    expr::lower_declarations(g, ir, diags);
+    declarations::lower_declarations(g, ir, diags);
     g.controllers.clone()
 }
 

@@ -1,0 +1,268 @@
+//! Stage 2, second half, the controllers: pass 1 declares every
+//! controller's commands, statuses, errors, vars and hooks; pass 2 checks
+//! var initialisers and lowers the plans (through `lower::plans`).
+
+use super::expr::Cx;
+use super::{duplicate, resolve_type, Globals};
+use crate::ast;
+use crate::diagnostic::{Code, Diagnostic, Diagnostics};
+use crate::ir::*;
+use crate::source::Span;
+
+/// Pass 1 for every controller: commands, statuses, errors, vars, hooks.
+pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnostics) {
+    for (i, c) in g.controllers.iter().enumerate() {
+        let mut commands: Vec<Command> = Vec::new();
+        let mut statuses = std::mem::take(&mut ir.controllers[i].statuses);
+        let mut errors: Vec<ErrorDef> = Vec::new();
+        let mut vars: Vec<Var> = Vec::new();
+        let mut hooks: Vec<Hook> = Vec::new();
+        // One value namespace: vars, hooks, buffers and subordinates.
+        let mut values: Vec<(String, Span)> = Vec::new();
+        for e in &c.entries {
+            match &e.kind {
+                ast::EntryKind::Reads(n, _) | ast::EntryKind::Writes(n, _) => {
+                    values.push((n.text.to_string(), n.span))
+                }
+                ast::EntryKind::Subordinates(ns) => {
+                    for n in ns {
+                        if !values.iter().any(|(v, _)| *v == n.text) {
+                            values.push((n.text.to_string(), n.span));
+                        }
+                    }
+                }
+                _ => {}
+            }
+        }
+        let mut claim = |name: &ast::Name, what: &str, diags: &mut Diagnostics| -> bool {
+            if let Some((_, first)) = values.iter().find(|(v, _)| *v == name.text) {
+                // `reads`, `writes` and `subordinates` were collected first;
+                // the diagnostic goes on whichever declaration comes later.
+                let (later, earlier) = if first.start > name.span.start {
+                    (*first, name.span)
+                } else {
+                    (name.span, *first)
+                };
+                diags.push(duplicate(what, &name.text, later, earlier));
+                false
+            } else {
+                values.push((name.text.to_string(), name.span));
+                true
+            }
+        };
+        for e in &c.entries {
+            let docs = &e.outer.docs;
+            match &e.kind {
+                ast::EntryKind::Command(name, params) => {
+                    if let Some(first) = commands.iter().find(|x| x.name == name.text) {
+                        diags.push(duplicate("command", &name.text, name.span, first.span));
+                        continue;
+                    }
+                    commands.push(Command {
+                        name: name.text.to_string(),
+                        docs: docs.clone(),
+                        params: lower_params(g, params, diags),
+                        plan: None,
+                        span: name.span,
+                    });
+                }
+                ast::EntryKind::Status(names) => {
+                    for name in names {
+                        if let Some(first) = statuses.iter().find(|x| x.name == name.text) {
+                            match first.span {
+                                Some(f) => diags.push(duplicate("status", &name.text, name.span, f)),
+                                None => diags.push(
+                                    Diagnostic::error(
+                                        Code::DuplicateDefinition,
+                                        format!("`{}` is a built-in status", name.text),
+                                        name.span,
+                                        "already defined by every controller",
+                                    )
+                                    .with_help("custom statuses come on top of NOT_READY, EXECUTING, DONE and ERROR"),
+                                ),
+                            }
+                            continue;
+                        }
+                        statuses.push(StatusDef {
+                            name: name.text.to_string(),
+                            docs: docs.clone(),
+                            span: Some(name.span),
+                        });
+                    }
+                }
+                ast::EntryKind::Error(names) => {
+                    for name in names {
+                        if let Some(first) = errors.iter().find(|x| x.name == name.text) {
+                            diags.push(duplicate("error code", &name.text, name.span, first.span));
+                            continue;
+                        }
+                        errors.push(ErrorDef {
+                            name: name.text.to_string(),
+                            docs: docs.clone(),
+                            span: name.span,
+                        });
+                    }
+                }
+                ast::EntryKind::Var { name, ty, .. } => {
+                    if !claim(name, "name", diags) {
+                        continue;
+                    }
+                    let ty = resolve_type(g, ty, diags);
+                    vars.push(Var {
+                        name: name.text.to_string(),
+                        docs: docs.clone(),
+                        // Unresolved: keep the var so its uses do not cascade.
+                        ty: ty.unwrap_or(Type::Unit),
+                        init: None,
+                        span: name.span,
+                    });
+                }
+                ast::EntryKind::Hook { name, params, ret } => {
+                    if !claim(name, "name", diags) {
+                        continue;
+                    }
+                    let params = lower_params(g, params, diags);
+                    let ret = match ret {
+                        Some(t) => resolve_type(g, t, diags).unwrap_or(Type::Unit),
+                        None => Type::Unit,
+                    };
+                    hooks.push(Hook {
+                        name: name.text.to_string(),
+                        docs: docs.clone(),
+                        params,
+                        ret,
+                        span: name.span,
+                    });
+                }
+                _ => {}
+            }
+        }
+        let ctrl = &mut ir.controllers[i];
+        ctrl.commands = commands;
+        ctrl.statuses = statuses;
+        ctrl.errors = errors;
+        ctrl.vars = vars;
+        ctrl.hooks = hooks;
+    }
+}
+
+fn lower_params(g: &Globals, params: &[ast::Param], diags: &mut Diagnostics) -> Vec<Param> {
+    let mut out: Vec<Param> = Vec::new();
+    for p in params {
+        if let Some(first) = out.iter().find(|x| x.name == p.name.text) {
+            diags.push(duplicate(
+                "parameter",
+                &p.name.text,
+                p.name.span,
+                first.span,
+            ));
+            continue;
+        }
+        let ty = resolve_type(g, &p.ty, diags).unwrap_or(Type::Unit);
+        out.push(Param {
+            name: p.name.text.to_string(),
+            docs: p.docs.clone(),
+            ty,
+            span: p.name.span,
+        });
+    }
+    out
+}
+
+/// Pass 2 for one controller: var initialisers and plans.
+pub(super) fn lower_controller_body(
+    g: &Globals,
+    ir: &mut Ir,
+    id: CtrlId,
+    c: &ast::ControllerDef,
+    diags: &mut Diagnostics,
+) {
+    let mut inits = Vec::new();
+    let mut plans: Vec<Plan> = Vec::new();
+    let mut plan_of: Vec<Option<PlanId>> = vec![None; ir.controllers[id.index()].commands.len()];
+    {
+        let ctrl = &ir.controllers[id.index()];
+        // Hooks whose declared return type did not resolve (already reported).
+        let unresolved_hooks: Vec<String> = c
+            .entries
+            .iter()
+            .filter_map(|e| match &e.kind {
+                ast::EntryKind::Hook {
+                    name, ret: Some(t), ..
+                } if resolve_type(g, t, &mut Diagnostics::new()).is_none() => {
+                    Some(name.text.to_string())
+                }
+                _ => None,
+            })
+            .collect();
+        let mut cx = Cx {
+            g,
+            ir,
+            ctrl: id,
+            c: ctrl,
+            plan_cmd: None,
+            const_ctx: true,
+            unresolved_hooks,
+            diags,
+        };
+        for e in &c.entries {
+            match &e.kind {
+                ast::EntryKind::Var {
+                    name,
+                    init: Some(init),
+                    ..
+                } => {
+                    let Some(vi) = ctrl
+                        .vars
+                        .iter()
+                        .position(|v| v.name == name.text && v.span == name.span)
+                    else {
+                        continue;
+                    };
+                    let ty = ctrl.vars[vi].ty.clone();
+                    if ty == Type::Unit {
+                        continue; // its type did not resolve; already reported
+                    }
+                    cx.const_ctx = true;
+                    cx.plan_cmd = None;
+                    let e = cx.check(init, &ty);
+                    inits.push((vi, e));
+                }
+                ast::EntryKind::Plan(p) => {
+                    let Some(cmd) = ctrl.commands.iter().position(|x| x.name == p.verb.text) else {
+                        cx.diags.push(
+                            Diagnostic::error(
+                                Code::UnknownCommand,
+                                format!("`{}` has no command `{}`", ctrl.name, p.verb.text),
+                                p.verb.span,
+                                "no such command",
+                            )
+                            .with_help(format!("declare it: `command {}`", p.verb.text)),
+                        );
+                        continue;
+                    };
+                    if let Some(prev) = plan_of[cmd] {
+                        let first: &Plan = &plans[prev.index()];
+                        cx.diags
+                            .push(duplicate("plan", &p.verb.text, p.verb.span, first.header));
+                        continue;
+                    }
+                    cx.const_ctx = false;
+                    cx.plan_cmd = Some(CommandId(cmd as u32));
+                    let plan = cx.plan(p, CommandId(cmd as u32), &e.outer);
+                    plan_of[cmd] = Some(PlanId(plans.len() as u32));
+                    plans.push(plan);
+                }
+                _ => {}
+            }
+        }
+    }
+    let ctrl = &mut ir.controllers[id.index()];
+    for (vi, e) in inits {
+        ctrl.vars[vi].init = Some(e);
+    }
+    for (cmd, p) in ctrl.commands.iter_mut().zip(plan_of) {
+        cmd.plan = p;
+    }
+    ctrl.plans = plans;
+}

@@ -1,0 +1,495 @@
+//! Stage 2, second half: plans, rows (state patterns, conditions,
+//! targets), jobs, sends and assignment places, checked through the
+//! expression checker of `lower::expr`.
+
+use super::expr::{Cx, Value};
+use super::*;
+use crate::ast::{self, AssignOp, BinOp};
+use crate::diagnostic::{Code, Diagnostic};
+use crate::ir::*;
+use crate::source::Span;
+
+impl Cx<'_, '_> {
+    pub(in crate::lower) fn plan(
+        &mut self,
+        p: &ast::PlanDef,
+        cmd: CommandId,
+        outer: &ast::Outer,
+    ) -> Plan {
+        let mut states = vec![State {
+            name: "S0".to_string(),
+            span: None,
+        }];
+        let mut rows = Vec::new();
+        for (pos, r) in p.rows.iter().enumerate() {
+            if let Some(row) = self.row(r, pos as u32, &mut states) {
+                rows.push(row);
+            }
+        }
+        let span = p
+            .rows
+            .last()
+            .map(|r| p.header.to(r.span))
+            .unwrap_or(p.header);
+        Plan {
+            verb: cmd,
+            docs: outer.docs.clone(),
+            states,
+            rows,
+            lints: outer.lints.iter().map(|(l, _)| *l).collect(),
+            header: p.header,
+            span,
+        }
+    }
+
+    pub(in crate::lower) fn row(
+        &mut self,
+        r: &ast::Row,
+        position: u32,
+        states: &mut Vec<State>,
+    ) -> Option<Row> {
+        let intern = |states: &mut Vec<State>, n: &ast::Name| -> StateId {
+            match states.iter().position(|s| s.name == n.text) {
+                Some(i) => {
+                    if states[i].span.is_none() {
+                        states[i].span = Some(n.span);
+                    }
+                    StateId(i as u32)
+                }
+                None => {
+                    states.push(State {
+                        name: n.text.to_string(),
+                        span: Some(n.span),
+                    });
+                    StateId(states.len() as u32 - 1)
+                }
+            }
+        };
+        let (from, from_span) = match &r.from {
+            ast::From::DontCare(n, s) => {
+                (From::DontCare(n.map(|n| n.min(u32::MAX as u64) as u32)), *s)
+            }
+            ast::From::Implicit => (From::DontCare(None), r.cond_span),
+            ast::From::State(n) if n.text == "Done" || n.text == "Error" => {
+                self.diags.push(
+                    Diagnostic::error(
+                        Code::UnreachableRow,
+                        format!("a row cannot start in `{}`", n.text),
+                        n.span,
+                        "terminal state",
+                    )
+                    .with_help(format!(
+                        "after `{}` the plan runs no rows until a new command arrives",
+                        n.text
+                    )),
+                );
+                (From::DontCare(None), n.span)
+            }
+            ast::From::State(n) => (From::State(intern(states, n)), n.span),
+        };
+        let (cond, is_entry) = match &r.cond {
+            None => (Condition::Otherwise, false),
+            Some(c) => {
+                let e = self.check(c, &Type::Bool);
+                let entry = has_new_command_conjunct(&e);
+                (Condition::When(e), entry)
+            }
+        };
+        let to = match &r.target {
+            ast::Target::Same(_) => Target::Same,
+            ast::Target::Error(None, _) => Target::Error(None),
+            ast::Target::Error(Some(code), _) => {
+                match self.c.errors.iter().position(|e| e.name == code.text) {
+                    Some(i) => Target::Error(Some(ErrorId(i as u32))),
+                    None => {
+                        self.diags.push(
+                            Diagnostic::error(
+                                Code::UnknownName,
+                                format!(
+                                    "controller `{}` has no error code `{}`",
+                                    self.c.name, code.text
+                                ),
+                                code.span,
+                                "not declared",
+                            )
+                            .with_help(format!("declare it: `error {}`", code.text)),
+                        );
+                        Target::Error(None)
+                    }
+                }
+            }
+            ast::Target::State(n) if n.text == "Done" => Target::Done,
+            ast::Target::State(n) => Target::State(intern(states, n)),
+        };
+        let jobs = r.jobs.iter().filter_map(|j| self.job(j)).collect();
+        Some(Row {
+            position,
+            label: r.label.map(|(n, _)| n.min(u32::MAX as u64) as u32),
+            docs: r.docs.clone(),
+            from,
+            cond,
+            is_entry,
+            to,
+            jobs,
+            line: 0,
+            span: r.span,
+            from_span,
+            cond_span: r.cond_span,
+            to_span: r.target.span(),
+            label_span: r.label.map(|(_, s)| s),
+        })
+    }
+
+    pub(in crate::lower) fn job(&mut self, j: &ast::Job) -> Option<Job> {
+        match j {
+            ast::Job::Report(name, span) => {
+                match self.c.statuses.iter().position(|s| s.name == name.text) {
+                    Some(i) if i >= 4 => Some(Job::Report {
+                        status: StatusId(i as u32),
+                        span: *span,
+                    }),
+                    Some(_) => {
+                        let target = match name.text.as_str() {
+                            "DONE" => "end the row with `-> Done`",
+                            "ERROR" => "end the row with `-> Error(CODE)`",
+                            _ => "the runtime sets it; report a custom status instead",
+                        };
+                        self.diags.push(
+                            Diagnostic::error(
+                                Code::UnknownName,
+                                format!(
+                                    "`report` takes a custom status, and `{}` is built in",
+                                    name.text
+                                ),
+                                name.span,
+                                "built-in status",
+                            )
+                            .with_help(target.to_string()),
+                        );
+                        None
+                    }
+                    None => {
+                        self.diags.push(
+                            Diagnostic::error(
+                                Code::UnknownName,
+                                format!(
+                                    "controller `{}` has no status `{}`",
+                                    self.c.name, name.text
+                                ),
+                                name.span,
+                                "not declared",
+                            )
+                            .with_help(format!("declare it: `status {}`", name.text)),
+                        );
+                        None
+                    }
+                }
+            }
+            ast::Job::Call(e) => {
+                let (x, _) = self.infer(e, None);
+                Some(Job::Call(x))
+            }
+            ast::Job::Assign {
+                place,
+                op,
+                value,
+                span,
+            } => {
+                let p = self.place(place)?;
+                if *op != AssignOp::Set && !matches!(p.ty, Type::Int(_) | Type::Float(_)) {
+                    self.mismatch(
+                        *span,
+                        format!(
+                            "`{}` needs a number, but the target is `{}`",
+                            if *op == AssignOp::Add { "+=" } else { "-=" },
+                            self.type_name(&p.ty)
+                        ),
+                        "not a number".to_string(),
+                    );
+                    self.infer_untyped(value);
+                    return None;
+                }
+                let v = self.check(value, &p.ty);
+                Some(Job::Assign {
+                    place: p,
+                    op: *op,
+                    value: v,
+                    span: *span,
+                })
+            }
+            ast::Job::Send {
+                sub,
+                verb,
+                args,
+                span,
+            } => self.send(sub, verb, args, *span),
+        }
+    }
+
+    pub(in crate::lower) fn send(
+        &mut self,
+        sub: &ast::Name,
+        verb: &ast::Name,
+        args: &[(ast::Name, ast::Expr)],
+        span: Span,
+    ) -> Option<Job> {
+        let infer_all = |cx: &mut Self| {
+            for (_, a) in args {
+                cx.infer_untyped(a);
+            }
+        };
+        let sid = match self
+            .c
+            .subordinates
+            .iter()
+            .find(|s| self.ir.controllers[s.index()].name == sub.text)
+        {
+            Some(s) => *s,
+            None => {
+                let help = if matches!(
+                    self.g.names.get(sub.text.as_str()),
+                    Some((ItemRef::Controller(_), _))
+                ) {
+                    format!(
+                        "add `{}` to `{}`'s `subordinates` list",
+                        sub.text, self.c.name
+                    )
+                } else {
+                    "commands go only to controllers listed in `subordinates`".to_string()
+                };
+                self.diags.push(
+                    Diagnostic::error(
+                        Code::UnknownSubordinate,
+                        format!("`{}` is not a subordinate of `{}`", sub.text, self.c.name),
+                        sub.span,
+                        "not a subordinate",
+                    )
+                    .with_help(help),
+                );
+                infer_all(self);
+                return None;
+            }
+        };
+        let target = &self.ir.controllers[sid.index()];
+        let Some(ci) = target.commands.iter().position(|c| c.name == verb.text) else {
+            self.diags.push(
+                Diagnostic::error(
+                    Code::UnknownCommand,
+                    format!("`{}` has no command `{}`", target.name, verb.text),
+                    verb.span,
+                    "no such command",
+                )
+                .with_help(format!(
+                    "`{}` accepts: {}",
+                    target.name,
+                    target
+                        .commands
+                        .iter()
+                        .map(|c| c.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )),
+            );
+            infer_all(self);
+            return None;
+        };
+        let command = &target.commands[ci];
+        let mut slots: Vec<Option<Expr>> = vec![None; command.params.len()];
+        let mut seen: Vec<Option<Span>> = vec![None; command.params.len()];
+        let mut ok = true;
+        for (n, a) in args {
+            match command.params.iter().position(|p| p.name == n.text) {
+                None => {
+                    self.diags.push(
+                        Diagnostic::error(
+                            Code::WrongArguments,
+                            format!(
+                                "command `{}` of `{}` has no parameter `{}`",
+                                command.name, target.name, n.text
+                            ),
+                            n.span,
+                            "unknown parameter",
+                        )
+                        .with_secondary(command.span, "command declared here"),
+                    );
+                    self.infer_untyped(a);
+                    ok = false;
+                }
+                Some(pi) => {
+                    if let Some(first) = seen[pi] {
+                        self.diags.push(
+                            Diagnostic::error(
+                                Code::WrongArguments,
+                                format!("parameter `{}` is given twice", n.text),
+                                n.span,
+                                "repeated argument",
+                            )
+                            .with_secondary(first, "first given here"),
+                        );
+                        self.infer_untyped(a);
+                        ok = false;
+                        continue;
+                    }
+                    seen[pi] = Some(n.span);
+                    let ty = command.params[pi].ty.clone();
+                    slots[pi] = Some(if ty == Type::Unit {
+                        self.infer_untyped(a).0
+                    } else {
+                        self.check(a, &ty)
+                    });
+                }
+            }
+        }
+        let missing: Vec<&str> = command
+            .params
+            .iter()
+            .zip(&slots)
+            .filter(|(_, s)| s.is_none())
+            .map(|(p, _)| p.name.as_str())
+            .collect();
+        if !missing.is_empty() && ok {
+            self.diags.push(
+                Diagnostic::error(
+                    Code::WrongArguments,
+                    format!(
+                        "command `{}` of `{}` is missing {}",
+                        command.name,
+                        target.name,
+                        missing
+                            .iter()
+                            .map(|m| format!("`{m}`"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                    span,
+                    "missing arguments",
+                )
+                .with_secondary(command.span, "command declared here")
+                .with_help(format!(
+                    "pass every parameter by name: `{} <- {}({})`",
+                    target.name,
+                    command.name,
+                    command
+                        .params
+                        .iter()
+                        .map(|p| format!("{}: …", p.name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )),
+            );
+            return None;
+        }
+        if !ok {
+            return None;
+        }
+        Some(Job::Send {
+            sub: sid,
+            command: CommandId(ci as u32),
+            args: slots.into_iter().map(|s| s.expect("all filled")).collect(),
+            span,
+        })
+    }
+
+    /// Resolve an assignment target, reporting `assign_to_input` for inputs.
+    pub(in crate::lower) fn place(&mut self, e: &ast::Expr) -> Option<Place> {
+        let input = |cx: &mut Self, what: String, help: &str| {
+            cx.diags.push(
+                Diagnostic::error(
+                    Code::AssignToInput,
+                    format!("cannot assign to {what}"),
+                    e.span,
+                    "an input of this controller",
+                )
+                .with_help(help.to_string()),
+            );
+            None
+        };
+        match &e.kind {
+            ast::ExprKind::Paren(i) => self.place(i),
+            ast::ExprKind::Path(None, n) => match self.value(&n.text) {
+                Some(Value::Var(v)) => {
+                    let ty = self.c.vars[v.index()].ty.clone();
+                    (ty != Type::Unit).then_some(Place { root: PlaceRoot::Var(v), path: Vec::new(), ty, span: e.span })
+                }
+                Some(Value::Buffer(b, true)) => Some(Place { root: PlaceRoot::Buffer(b), path: Vec::new(), ty: Type::Buffer(self.ir.buffers[b.index()].ty), span: e.span }),
+                Some(Value::Buffer(_, false)) => input(self, format!("`{}`, a buffer this controller reads", n.text), "only `writes` buffers and `var`s can be assigned; another controller or an external writer owns this one"),
+                Some(Value::Sub) => input(self, format!("subordinate `{}`", n.text), "command a subordinate with `X <- VERB(…)`"),
+                Some(Value::Hook(_)) => input(self, format!("hook `{}`", n.text), "hooks are functions; call them"),
+                None => {
+                    self.infer(e, None);
+                    None
+                }
+            },
+            ast::ExprKind::CmdParam(p) => input(self, format!("`cmd.{}`", p.text), "the command buffer belongs to the supervisor; copy the value into a `var`"),
+            ast::ExprKind::Field(base, f) => {
+                if let ast::ExprKind::Path(None, x) = &base.kind {
+                    if let Some((ItemRef::Controller(_), _)) = self.g.names.get(x.text.as_str()) {
+                        if self.value(&x.text).is_none() || matches!(self.value(&x.text), Some(Value::Sub)) {
+                            return input(self, format!("`{}.{}`", x.text, f.text), "a subordinate's status is written by the subordinate");
+                        }
+                    }
+                }
+                let mut p = self.place(base)?;
+                match &p.ty {
+                    Type::Buffer(bid) => {
+                        let bty = &self.ir.buffer_types[bid.index()];
+                        match bty.fields.iter().position(|x| x.name == f.text) {
+                            Some(fi) => {
+                                p.ty = bty.fields[fi].ty.clone();
+                                if p.ty == Type::Unit {
+                                    return None; // its type did not resolve; already reported
+                                }
+                                p.path.push(Projection::Field(fi as u32));
+                                p.span = e.span;
+                                Some(p)
+                            }
+                            None => {
+                                self.diags.push(Diagnostic::error(Code::UnknownName, format!("buffer type `{}` has no field `{}`", bty.name, f.text), f.span, "no such field")
+                                    .with_help(format!("the fields are: {}", bty.fields.iter().map(|f| f.name.as_str()).collect::<Vec<_>>().join(", "))));
+                                None
+                            }
+                        }
+                    }
+                    t => {
+                        let t = self.type_name(t);
+                        self.mismatch(f.span, format!("`{t}` has no fields"), format!("no field `{}`", f.text));
+                        None
+                    }
+                }
+            }
+            ast::ExprKind::Index(base, idx) => {
+                let mut p = self.place(base)?;
+                let n = self.const_index(idx)?;
+                match p.ty.clone() {
+                    Type::Array(elem, len) => {
+                        if n >= len as u64 {
+                            self.mismatch(idx.span, format!("index {n} is out of bounds for an array of length {len}"), format!("valid indices are 0 to {}", len - 1));
+                            return None;
+                        }
+                        p.ty = *elem;
+                        p.path.push(Projection::Index(n as u32));
+                        p.span = e.span;
+                        Some(p)
+                    }
+                    t => {
+                        let t = self.type_name(&t);
+                        self.mismatch(base.span, format!("cannot index into `{t}`"), "not an array".to_string());
+                        None
+                    }
+                }
+            }
+            _ => input(self, "this expression".to_string(), "assign to a `var`, a `writes` buffer, or a field or element of one"),
+        }
+    }
+}
+
+/// Whether `new_command` is a top-level conjunct of a condition.
+pub fn has_new_command_conjunct(e: &Expr) -> bool {
+    match &e.kind {
+        ExprKind::NewCommand => true,
+        ExprKind::Binary(BinOp::And, l, r) => {
+            has_new_command_conjunct(l) || has_new_command_conjunct(r)
+        }
+        _ => false,
+    }
+}

@@ -50,11 +50,8 @@ pub fn tables(terms: &Terms, cells: &[Vec<Value>]) -> Vec<Option<Vec<bool>>> {
                 [leaf] => Some(
                     cells[*leaf]
                         .iter()
-                        .map(|cell| {
-                            let value =
-                                |l: &Leaf| (terms.find(l) == Some(*leaf)).then(|| cell.clone());
-                            truth(eval(&atom.expr, &value))
-                        })
+                        // Every leaf the atom reads is this one.
+                        .map(|cell| truth(eval(&atom.expr, &|_| Some(cell.clone()))))
                         .collect(),
                 ),
                 _ => None,

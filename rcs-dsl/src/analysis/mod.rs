@@ -47,7 +47,7 @@ pub mod terms;
 use crate::ir::{Condition, Controller, CtrlId, From, Ir, Plan, StateId, StatusId, Type};
 use rcs_runtime::driver::Value;
 use search::{Mode, Outcome, Search};
-use std::rc::Rc;
+use std::sync::Arc;
 use terms::{Formula, Leaf, LeafId, Terms};
 
 /// The answer to "can this happen?".
@@ -95,7 +95,7 @@ pub struct PlanAnalysis<'ir> {
     plan: &'ir Plan,
     terms: Terms,
     /// Per row: its condition (`None` for `otherwise`).
-    conds: Vec<Option<Rc<Formula>>>,
+    conds: Vec<Option<Arc<Formula>>>,
     /// Per leaf: a representative value of each of its cells.
     cells: Vec<Vec<Value>>,
     /// Per atom: for an exact one, its truth value on each cell of its leaf.
@@ -126,7 +126,7 @@ impl<'ir> PlanAnalysis<'ir> {
             .rows
             .iter()
             .map(|r| match &r.cond {
-                Condition::When(e) => Some(Rc::new(terms.formula(e))),
+                Condition::When(e) => Some(Arc::new(terms.formula(e))),
                 Condition::Otherwise => None,
             })
             .collect();

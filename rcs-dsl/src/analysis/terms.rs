@@ -51,7 +51,7 @@ pub enum Formula {
     And(Vec<Formula>),
     Or(Vec<Formula>),
     /// A formula shared between questions (a row's condition), not copied.
-    Shared(std::rc::Rc<Formula>),
+    Shared(std::sync::Arc<Formula>),
 }
 
 impl Formula {

@@ -89,28 +89,7 @@ pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagno
     // The analysis of every plan's conditions and its graph first: the
     // checks of a plan ask its own, the handshake checks their
     // subordinates'.
-    let conditions: Vec<Vec<PlanAnalysis>> = ir
-        .controllers
-        .iter()
-        .map(|c| {
-            c.plans
-                .iter()
-                .map(|p| PlanAnalysis::new(ir, c, p))
-                .collect()
-        })
-        .collect();
-    let graphs: Vec<Vec<graph::Analysis>> = ir
-        .controllers
-        .iter()
-        .zip(&conditions)
-        .map(|(c, cs)| {
-            c.plans
-                .iter()
-                .zip(cs)
-                .map(|(p, a)| graph::analyse(p, a))
-                .collect()
-        })
-        .collect();
+    let (conditions, graphs) = analyse_plans(ir);
     for (ci, c) in ir.controllers.iter().enumerate() {
         for (pi, p) in c.plans.iter().enumerate() {
             let (conditions, analysis) = (&conditions[ci][pi], &graphs[ci][pi]);
@@ -133,4 +112,56 @@ pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagno
     usage::check_float_equality(ir, &mut sink);
     usage::check_unused(ir, &mut sink);
     diags.sort_from(start, sources);
+}
+
+/// Per controller, per plan: the analysis of its conditions, and its graph.
+type Analysed<'ir> = (Vec<Vec<PlanAnalysis<'ir>>>, Vec<Vec<graph::Analysis>>);
+
+/// The analysis of every plan and its graph (which asks the analysis most
+/// of the questions the checks need, and remembers the proofs), on as many
+/// threads as the machine has: plans are independent, and this is most of
+/// the time of the checks. Results come back in controller order, so the
+/// findings do not depend on the threads.
+fn analyse_plans(ir: &Ir) -> Analysed<'_> {
+    fn analyse<'ir>(
+        ir: &'ir Ir,
+        c: &'ir Controller,
+    ) -> (Vec<PlanAnalysis<'ir>>, Vec<graph::Analysis>) {
+        let conditions: Vec<PlanAnalysis> = c
+            .plans
+            .iter()
+            .map(|p| PlanAnalysis::new(ir, c, p))
+            .collect();
+        let graphs = c
+            .plans
+            .iter()
+            .zip(&conditions)
+            .map(|(p, a)| graph::analyse(p, a))
+            .collect();
+        (conditions, graphs)
+    }
+    let plans: usize = ir.controllers.iter().map(|c| c.plans.len()).sum();
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(ir.controllers.len());
+    // Below a few dozen plans a thread costs more than it saves.
+    let per_controller: Vec<_> = if threads < 2 || plans < 64 {
+        ir.controllers.iter().map(|c| analyse(ir, c)).collect()
+    } else {
+        let chunk = ir.controllers.len().div_ceil(threads);
+        std::thread::scope(|scope| {
+            let handles: Vec<_> = ir
+                .controllers
+                .chunks(chunk)
+                .map(|part| {
+                    scope.spawn(move || part.iter().map(|c| analyse(ir, c)).collect::<Vec<_>>())
+                })
+                .collect();
+            handles
+                .into_iter()
+                .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+                .collect()
+        })
+    };
+    per_controller.into_iter().unzip()
 }

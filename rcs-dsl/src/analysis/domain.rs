@@ -14,7 +14,7 @@
 
 use super::eval::eval;
 use super::terms::{Leaf, Terms};
-use crate::ir::{FloatTy, IntTy, Ir, StatusId, Type};
+use crate::ir::{FloatTy, IntTy, Ir, Type};
 use rcs_runtime::driver::Value;
 
 /// Per leaf, the representative value of each of its cells.
@@ -240,12 +240,4 @@ fn extra(ir: &Ir, ty: &Type, numbers: &[f64]) -> Vec<Value> {
         }
         other => cells_of(ir, other, &[]),
     }
-}
-
-/// The name of a status value of controller `c`, for witnesses.
-pub fn status_name(ir: &Ir, c: crate::ir::CtrlId, s: u16) -> String {
-    ir.controller(c)
-        .statuses
-        .get(s as usize)
-        .map_or_else(|| StatusId::BUILTIN[0].to_string(), |d| d.name.clone())
 }

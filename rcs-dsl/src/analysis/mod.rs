@@ -503,7 +503,12 @@ impl<'ir> PlanAnalysis<'ir> {
                     .map_or("?", |v| v.name.as_str());
                 format!("{}::{variant}", def.name)
             }
-            (Type::Status(c), Value::Status(s)) => domain::status_name(self.ir, *c, *s),
+            (Type::Status(c), Value::Status(s)) => self
+                .ir
+                .controller(*c)
+                .statuses
+                .get(*s as usize)
+                .map_or_else(|| format!("?{s}"), |d| d.name.clone()),
             (_, v) => format!("{v:?}"),
         }
     }

@@ -1,0 +1,269 @@
+//! Stage 1, the builder: expressions — operator chains folded by
+//! precedence (with the depth limit), operands, postfix projections and
+//! primaries.
+
+use super::*;
+
+impl Builder {
+    pub(in crate::parser) fn expr(&mut self, p: Pair<Rule>) -> Expr {
+        self.expr_at(p, 0)
+    }
+
+    pub(in crate::parser) fn too_deep(&mut self, span: Span) -> Expr {
+        self.error(
+            span,
+            format!("expression nested more than {MAX_EXPR_DEPTH} deep"),
+            "too deep",
+        );
+        self.diags.last_mut().expect("just pushed").help = Some(
+            "split it: compute parts in earlier rows' jobs into `var`s, or in a hook".to_string(),
+        );
+        Expr {
+            kind: ExprKind::Bool(false),
+            span,
+        }
+    }
+
+    /// Build an expression whose root sits at tree depth `depth`. Operator
+    /// chains are folded by precedence climbing with explicit stacks, and
+    /// every node's depth is bounded by [`MAX_EXPR_DEPTH`], so no input can
+    /// make this (or the type checker after it) recurse without limit.
+    pub(in crate::parser) fn expr_at(&mut self, p: Pair<Rule>, depth: usize) -> Expr {
+        let span = self.span(&p);
+        if depth > MAX_EXPR_DEPTH {
+            return self.too_deep(span);
+        }
+        let mut operands: Vec<(Expr, usize)> = Vec::new();
+        let mut ops: Vec<BinOp> = Vec::new();
+        let mut failed = false;
+        let reduce = |operands: &mut Vec<(Expr, usize)>, op: BinOp| {
+            let (r, dr) = operands.pop().expect("right operand");
+            let (l, dl) = operands.pop().expect("left operand");
+            let span = l.span.to(r.span);
+            let d = dl.max(dr) + 1;
+            operands.push((
+                Expr {
+                    kind: ExprKind::Binary(op, Box::new(l), Box::new(r)),
+                    span,
+                },
+                d,
+            ));
+            d
+        };
+        for c in p.into_inner() {
+            if c.as_rule() == Rule::operand {
+                let (e, d) = self.operand(c, depth);
+                operands.push((e, d));
+                continue;
+            }
+            let op = bin_op(c.as_str());
+            // Left-associative: reduce while the stacked operator binds at least as tightly.
+            while let Some(&top) = ops.last() {
+                if top.precedence() < op.precedence() {
+                    break;
+                }
+                ops.pop();
+                if reduce(&mut operands, top) + depth > MAX_EXPR_DEPTH {
+                    failed = true;
+                }
+            }
+            ops.push(op);
+            if failed {
+                break;
+            }
+        }
+        if failed {
+            return self.too_deep(span);
+        }
+        while let Some(op) = ops.pop() {
+            if reduce(&mut operands, op) + depth > MAX_EXPR_DEPTH {
+                return self.too_deep(span);
+            }
+        }
+        operands.pop().expect("an expression has an operand").0
+    }
+
+    /// `op_unary* postfix (as T)*`; returns the node and its height.
+    pub(in crate::parser) fn operand(&mut self, p: Pair<Rule>, depth: usize) -> (Expr, usize) {
+        let mut prefixes = Vec::new();
+        let mut base = None;
+        let mut casts = Vec::new();
+        for c in p.into_inner() {
+            match c.as_rule() {
+                Rule::op_unary => prefixes.push((c.as_str() == "!", self.span(&c))),
+                Rule::postfix_expr => base = Some(c),
+                Rule::ident => casts.push(c),
+                _ => {}
+            }
+        }
+        let wrappers = prefixes.len() + casts.len();
+        let base = base.expect("operand has a base");
+        if wrappers + depth > MAX_EXPR_DEPTH {
+            let span = self.span(&base);
+            return (self.too_deep(span), 1);
+        }
+        let (mut e, mut h) = self.postfix(base, depth + wrappers);
+        for ty in casts {
+            let ty = self.name(ty);
+            let span = e.span.to(ty.span);
+            e = Expr {
+                kind: ExprKind::Cast(Box::new(e), ty),
+                span,
+            };
+            h += 1;
+        }
+        for (not, op_span) in prefixes.into_iter().rev() {
+            let span = op_span.to(e.span);
+            let op = if not { UnOp::Not } else { UnOp::Neg };
+            e = Expr {
+                kind: ExprKind::Unary(op, Box::new(e)),
+                span,
+            };
+            h += 1;
+        }
+        (e, h)
+    }
+
+    pub(in crate::parser) fn postfix(&mut self, p: Pair<Rule>, depth: usize) -> (Expr, usize) {
+        let mut inner = p.into_inner();
+        let first = inner.next().expect("primary");
+        let suffixes: Vec<Pair<Rule>> = inner.collect();
+        if suffixes.len() + depth > MAX_EXPR_DEPTH {
+            let span = self.span(&first);
+            return (self.too_deep(span), 1);
+        }
+        let (mut e, mut h) = self.primary(first, depth + suffixes.len());
+        let mut suffixes = suffixes.into_iter().peekable();
+        // `cmd.P`: the command parameter, not a field of something named `cmd`.
+        if matches!(&e.kind, ExprKind::Path(None, n) if n.text == "cmd") {
+            let param = suffixes
+                .next_if(|s| {
+                    s.clone()
+                        .into_inner()
+                        .next()
+                        .is_some_and(|c| c.as_rule() == Rule::ident)
+                })
+                .map(|s| s.into_inner().next().expect("field name"));
+            match param {
+                Some(p) => {
+                    let span = e.span.to(self.span(&p));
+                    e = Expr {
+                        kind: ExprKind::CmdParam(self.name(p)),
+                        span,
+                    };
+                }
+                None => {
+                    let span = e.span;
+                    self.error(
+                        span,
+                        "`cmd` alone is not a value",
+                        "expected `cmd.PARAMETER`",
+                    );
+                    self.diags.last_mut().expect("just pushed").help =
+                        Some("read a parameter of the current command as `cmd.NAME`".to_string());
+                }
+            }
+        }
+        for s in suffixes {
+            let sspan = self.span(&s);
+            let span = e.span.to(sspan);
+            let c = s.into_inner().next().expect("suffix has one child");
+            e = match c.as_rule() {
+                // `status` and `error` are keywords but valid after a dot.
+                Rule::kw_status | Rule::kw_error => Expr {
+                    kind: ExprKind::Field(
+                        Box::new(e),
+                        Name {
+                            text: c.as_str().into(),
+                            span: self.span(&c),
+                        },
+                    ),
+                    span,
+                },
+                Rule::ident => Expr {
+                    kind: ExprKind::Field(Box::new(e), self.name(c)),
+                    span,
+                },
+                _ => {
+                    let idx = self.expr_at(c, depth + 1);
+                    Expr {
+                        kind: ExprKind::Index(Box::new(e), Box::new(idx)),
+                        span,
+                    }
+                }
+            };
+            h += 1;
+        }
+        (e, h)
+    }
+
+    pub(in crate::parser) fn primary(&mut self, p: Pair<Rule>, depth: usize) -> (Expr, usize) {
+        let span = self.span(&p);
+        let mut height = 1;
+        let kind = match p.as_rule() {
+            Rule::number if p.as_str().contains(['.', 'e', 'E']) => {
+                match p.as_str().replace('_', "").parse::<f64>() {
+                    Ok(v) if v.is_finite() => ExprKind::Float(v),
+                    _ => {
+                        self.error(span, "float literal is out of range", "not a finite f64");
+                        ExprKind::Float(0.0)
+                    }
+                }
+            }
+            Rule::number => match p.as_str().replace('_', "").parse::<u128>() {
+                Ok(v) if v <= u64::MAX as u128 => ExprKind::Int(v),
+                _ => {
+                    self.error(
+                        span,
+                        "integer literal is too large",
+                        "does not fit in 64 bits",
+                    );
+                    ExprKind::Int(0)
+                }
+            },
+            Rule::name_expr => {
+                let mut inner = p.into_inner();
+                let first = inner.next().expect("a name");
+                match (first.as_str(), inner.peek().map(|c| c.as_rule())) {
+                    ("true", None) => ExprKind::Bool(true),
+                    ("false", None) => ExprKind::Bool(false),
+                    ("new_command", None) => ExprKind::NewCommand,
+                    ("state_cycles", None) => ExprKind::StateCycles,
+                    ("plan_cycles", None) => ExprKind::PlanCycles,
+                    // Left for `postfix`, which turns `cmd.P` into a parameter.
+                    ("cmd", None) => ExprKind::Path(
+                        None,
+                        Name {
+                            text: "cmd".into(),
+                            span,
+                        },
+                    ),
+                    (_, Some(Rule::call_args)) => {
+                        let name = self.name(first);
+                        let args = inner
+                            .next()
+                            .expect("arguments")
+                            .into_inner()
+                            .map(|a| self.expr_at(a, depth + 1))
+                            .collect();
+                        height = 2;
+                        ExprKind::Call(name, args)
+                    }
+                    (_, Some(_)) => {
+                        let qualifier = self.name(first);
+                        let name = self.name(inner.next().expect("variant"));
+                        ExprKind::Path(Some(qualifier), name)
+                    }
+                    (_, None) => ExprKind::Path(None, self.name(first)),
+                }
+            }
+            Rule::paren => {
+                let e = self.expr_at(p.into_inner().next().expect("inner"), depth + 1);
+                height = 2;
+                ExprKind::Paren(Box::new(e))
+            }
+            _ => unreachable!("primary alternatives are listed in the grammar"),
+        };
+        (Expr { kind, span }, height)
+    }
+}

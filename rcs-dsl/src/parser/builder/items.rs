@@ -1,0 +1,199 @@
+//! Stage 1, the builder: items (enums, buffers, controllers), their fields,
+//! types and parameters, and the entries of a controller.
+
+use super::*;
+
+impl Builder {
+    pub(in crate::parser) fn item(&mut self, p: Pair<Rule>) -> Option<Item> {
+        let (outer, mut rest) = self.split_outer(p);
+        let def = rest.pop()?;
+        let span = self.span(&def);
+        match def.as_rule() {
+            Rule::enum_def => self.no_attributes(&outer, "an enum"),
+            Rule::buffer_def => self.no_attributes(&outer, "a buffer"),
+            _ => {}
+        }
+        let mut inner = def.clone().into_inner();
+        Some(match def.as_rule() {
+            Rule::enum_def => {
+                inner.next(); // kw
+                let name = self.name(inner.next()?);
+                let variants = inner
+                    .map(|v| {
+                        let mut docs = Vec::new();
+                        let mut name = None;
+                        for c in v.into_inner() {
+                            match c.as_rule() {
+                                Rule::doc_comment => docs.push(Self::doc(&c)),
+                                _ => name = Some(self.name(c)),
+                            }
+                        }
+                        (docs, name.expect("variant has a name"))
+                    })
+                    .collect();
+                Item::Enum(EnumDef {
+                    outer,
+                    name,
+                    variants,
+                    span,
+                })
+            }
+            Rule::buffer_def => {
+                inner.next();
+                let name = self.name(inner.next()?);
+                let fields = inner.map(|f| self.field(f)).collect();
+                Item::Buffer(BufferDef {
+                    outer,
+                    name,
+                    fields,
+                    span,
+                })
+            }
+            Rule::controller_def => {
+                inner.next();
+                let name = self.name(inner.next()?);
+                let mut title = None;
+                let mut entries = Vec::new();
+                for c in inner {
+                    match c.as_rule() {
+                        Rule::string_lit => {
+                            let s = c.as_str();
+                            title = Some(unescape(&s[1..s.len() - 1]));
+                        }
+                        Rule::entry => {
+                            if let Some(e) = self.entry(c) {
+                                entries.push(e);
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+                Item::Controller(ControllerDef {
+                    outer,
+                    name,
+                    title,
+                    entries,
+                    span,
+                })
+            }
+            _ => return None,
+        })
+    }
+
+    pub(in crate::parser) fn field(&mut self, p: Pair<Rule>) -> Field {
+        let mut docs = Vec::new();
+        let mut name = None;
+        let mut ty = None;
+        for c in p.into_inner() {
+            match c.as_rule() {
+                Rule::doc_comment => docs.push(Self::doc(&c)),
+                Rule::ident => name = Some(self.name(c)),
+                Rule::type_expr => ty = Some(self.type_expr(c)),
+                _ => {}
+            }
+        }
+        Field {
+            docs,
+            name: name.expect("field has a name"),
+            ty: ty.expect("field has a type"),
+        }
+    }
+
+    pub(in crate::parser) fn type_expr(&mut self, p: Pair<Rule>) -> TypeExpr {
+        let c = p.into_inner().next().expect("type_expr has one child");
+        match c.as_rule() {
+            Rule::array_type => {
+                let span = self.span(&c);
+                let mut inner = c.into_inner();
+                let elem = self.type_expr(inner.next().expect("element type"));
+                let len = self.int(inner.next().expect("array length"));
+                TypeExpr::Array {
+                    elem: Box::new(elem),
+                    len,
+                    span,
+                }
+            }
+            _ => TypeExpr::Named(self.name(c)),
+        }
+    }
+
+    pub(in crate::parser) fn params<'i>(
+        &mut self,
+        pairs: impl Iterator<Item = Pair<'i, Rule>>,
+    ) -> Vec<Param> {
+        pairs
+            .filter(|p| p.as_rule() == Rule::param)
+            .map(|p| {
+                // A parameter is written like a buffer field: docs, name, type.
+                let Field { docs, name, ty } = self.field(p);
+                Param { docs, name, ty }
+            })
+            .collect()
+    }
+
+    pub(in crate::parser) fn entry(&mut self, p: Pair<Rule>) -> Option<Entry> {
+        let span = self.span(&p);
+        let (outer, mut rest) = self.split_outer(p);
+        let decl = rest.pop()?;
+        let rule = decl.as_rule();
+        if rule != Rule::plan_def {
+            self.no_attributes(&outer, "this entry");
+        }
+        let mut inner = decl.clone().into_inner();
+        inner.next(); // the keyword
+        let kind = match rule {
+            Rule::level_decl => {
+                let n = inner.next()?;
+                let s = self.span(&n);
+                EntryKind::Level(self.int(n), s)
+            }
+            Rule::subordinates_decl => {
+                EntryKind::Subordinates(inner.map(|n| self.name(n)).collect())
+            }
+            Rule::reads_decl | Rule::writes_decl => {
+                let name = self.name(inner.next()?);
+                let ty = self.name(inner.next()?);
+                if rule == Rule::reads_decl {
+                    EntryKind::Reads(name, ty)
+                } else {
+                    EntryKind::Writes(name, ty)
+                }
+            }
+            Rule::command_decl => {
+                let name = self.name(inner.next()?);
+                EntryKind::Command(name, self.params(inner))
+            }
+            Rule::status_decl => EntryKind::Status(inner.map(|n| self.name(n)).collect()),
+            Rule::error_decl => EntryKind::Error(inner.map(|n| self.name(n)).collect()),
+            Rule::var_decl => {
+                let name = self.name(inner.next()?);
+                let ty = self.type_expr(inner.next()?);
+                let init = inner.next().map(|e| self.expr(e));
+                EntryKind::Var { name, ty, init }
+            }
+            Rule::hook_decl => {
+                let name = self.name(inner.next()?);
+                let mut params = Vec::new();
+                let mut ret = None;
+                for c in inner {
+                    match c.as_rule() {
+                        Rule::param => params.extend(self.params(std::iter::once(c))),
+                        Rule::type_expr => ret = Some(self.type_expr(c)),
+                        _ => {}
+                    }
+                }
+                EntryKind::Hook { name, params, ret }
+            }
+            Rule::plan_def => {
+                let kw = decl.clone().into_inner().next()?;
+                let verb_pair = inner.next()?;
+                let header = self.span(&kw).to(self.span(&verb_pair));
+                let verb = self.name(verb_pair);
+                let rows = inner.map(|r| self.row(r)).collect();
+                EntryKind::Plan(PlanDef { verb, header, rows })
+            }
+            _ => return None,
+        };
+        Some(Entry { outer, kind, span })
+    }
+}

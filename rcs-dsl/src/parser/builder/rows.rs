@@ -1,0 +1,190 @@
+//! Stage 1, the builder: plan rows (labels, state patterns, conditions,
+//! targets) and their jobs.
+
+use super::*;
+
+impl Builder {
+    pub(in crate::parser) fn row(&mut self, p: Pair<Rule>) -> Row {
+        let span = self.span(&p);
+        let mut docs = Vec::new();
+        let mut label = None;
+        let mut body = Vec::new();
+        for c in p.into_inner() {
+            match c.as_rule() {
+                Rule::doc_comment => docs.push(Self::doc(&c)),
+                Rule::row_label => {
+                    let s = self.span(&c);
+                    let n = c.as_str()[1..].parse::<u64>().unwrap_or(u64::MAX);
+                    label = Some((n, s));
+                }
+                _ => body.push(c),
+            }
+        }
+        let mut from = None;
+        let mut otherwise = None;
+        let mut when = None;
+        let mut cond = None;
+        let mut cond_span = span;
+        let mut target = None;
+        let mut jobs = Vec::new();
+        for c in body {
+            match c.as_rule() {
+                Rule::from_state => {
+                    let c = c.into_inner().next().expect("from has one child");
+                    from = Some(match c.as_rule() {
+                        Rule::dont_care => self.dont_care(c),
+                        _ => From::State(self.name(c)),
+                    });
+                }
+                Rule::kw_otherwise => {
+                    cond_span = self.span(&c);
+                    otherwise = Some(cond_span);
+                }
+                Rule::kw_when => when = Some(self.span(&c)),
+                Rule::expr => {
+                    cond_span = self.span(&c);
+                    cond = Some(self.expr(c));
+                }
+                Rule::target => target = Some(self.target(c)),
+                Rule::jobs => jobs = c.into_inner().map(|j| self.job(j)).collect(),
+                _ => {}
+            }
+        }
+        let from = match (from, otherwise) {
+            (Some(From::State(n)), Some(_)) => {
+                self.error(
+                    n.span,
+                    format!("an `otherwise` row cannot start in state `{}`", n.text),
+                    "`otherwise` applies in every state",
+                );
+                self.diags.last_mut().expect("just pushed").help =
+                    Some("write `otherwise -> …` or `*N otherwise -> …`".to_string());
+                From::Implicit
+            }
+            (Some(f), _) => f,
+            (None, Some(_)) => From::Implicit,
+            (None, None) => {
+                self.error(
+                    when.unwrap_or(cond_span),
+                    "expected a state or `*` before `when`",
+                    "this row names no state",
+                );
+                self.diags.last_mut().expect("just pushed").help =
+                    Some("start the row with the state it applies in (`S1 when …`) or `*` for every state".to_string());
+                From::Implicit
+            }
+        };
+        debug_assert!(otherwise.is_some() == cond.is_none());
+        Row {
+            docs,
+            label,
+            from,
+            cond,
+            cond_span,
+            target: target.expect("row has a target"),
+            jobs,
+            span,
+        }
+    }
+
+    pub(in crate::parser) fn dont_care(&mut self, p: Pair<Rule>) -> From {
+        let span = self.span(&p);
+        let digits = &p.as_str()[1..];
+        let n = if digits.is_empty() {
+            None
+        } else {
+            Some(digits.parse::<u64>().unwrap_or(u64::MAX))
+        };
+        From::DontCare(n, span)
+    }
+
+    pub(in crate::parser) fn target(&mut self, p: Pair<Rule>) -> Target {
+        let c = p.into_inner().next().expect("target has one child");
+        let span = self.span(&c);
+        match c.as_rule() {
+            Rule::kw_same => Target::Same(span),
+            Rule::error_target => {
+                let code = c.into_inner().nth(1).map(|n| self.name(n));
+                Target::Error(code, span)
+            }
+            _ => Target::State(self.name(c)),
+        }
+    }
+
+    pub(in crate::parser) fn job(&mut self, p: Pair<Rule>) -> Job {
+        let c = p.into_inner().next().expect("job has one child");
+        let span = self.span(&c);
+        match c.as_rule() {
+            Rule::report_job => {
+                let n = self.name(c.into_inner().nth(1).expect("status"));
+                Job::Report(n, span)
+            }
+            _ => {
+                let mut inner = c.into_inner();
+                let first = inner.next().expect("place");
+                match inner.next() {
+                    Some(arrow) if arrow.as_rule() == Rule::send_arrow => {
+                        // `X <- VERB(args)`: the name before `<-` is the subordinate.
+                        let sub_span = self.span(&first);
+                        let place = self.postfix(first, 0).0;
+                        let sub = match place.kind {
+                            ExprKind::Path(None, n) => n,
+                            _ => {
+                                self.error(
+                                    sub_span,
+                                    "expected a subordinate's name before `<-`",
+                                    "not a controller name",
+                                );
+                                Name {
+                                    text: Default::default(),
+                                    span: sub_span,
+                                }
+                            }
+                        };
+                        let verb = self.name(inner.next().expect("verb"));
+                        let args = inner
+                            .map(|a| {
+                                let mut ai = a.into_inner();
+                                let n = self.name(ai.next().expect("arg name"));
+                                let e = self.expr(ai.next().expect("arg value"));
+                                (n, e)
+                            })
+                            .collect();
+                        Job::Send {
+                            sub,
+                            verb,
+                            args,
+                            span,
+                        }
+                    }
+                    Some(op) => {
+                        let place = self.postfix(first, 0).0;
+                        let op = match op.as_str() {
+                            "+=" => AssignOp::Add,
+                            "-=" => AssignOp::Sub,
+                            _ => AssignOp::Set,
+                        };
+                        let value = self.expr(inner.next().expect("assigned value"));
+                        Job::Assign {
+                            place,
+                            op,
+                            value,
+                            span,
+                        }
+                    }
+                    None => {
+                        let place = self.postfix(first, 0).0;
+                        if !matches!(place.kind, ExprKind::Call(..)) {
+                            self.error(
+                                span,
+                                "expected a job: an assignment, `X <- VERB`, `report S` or a hook call",
+                                "this expression does nothing",
+                            );
+                        }
+                        Job::Call(place)
+                    }
+                }
+            }
+        }
+    }
+}

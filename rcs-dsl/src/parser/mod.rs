@@ -1,0 +1,151 @@
+//! Stage 1 of the pipeline: text → [`ast::File`]. pest does the matching;
+//! this module turns its pairs into the AST and its failures into `syntax`
+//! diagnostics phrased in the user's words.
+//!
+//! Hostile input is bounded here: a size limit, a bracket-nesting limit
+//! checked before pest runs (so no input can exhaust the stack), and an
+//! expression-depth limit while folding operator chains.
+//!
+//! Pairs become AST nodes in [`builder`]; pest's failures become
+//! diagnostics in [`syntax_error`].
+
+use crate::ast::*;
+use crate::diagnostic::{Code, Diagnostic};
+use crate::source::{FileId, Span};
+use pest::Parser as _;
+
+mod builder;
+mod syntax_error;
+
+use builder::Builder;
+pub use builder::RESERVED;
+use syntax_error::syntax_error;
+
+#[derive(pest_derive::Parser)]
+#[grammar = "grammar.pest"]
+struct RcsParser;
+
+/// Largest accepted source file.
+pub const MAX_FILE_BYTES: usize = 16 * 1024 * 1024;
+/// Deepest accepted nesting of `(`, `[` and `{`.
+pub const MAX_NESTING: usize = 64;
+/// Deepest accepted expression tree (operator chains count one level per operator).
+pub const MAX_EXPR_DEPTH: usize = 256;
+
+/// Parse one file. On failure, returns its `syntax` diagnostics.
+pub fn parse_file(file: FileId, text: &str) -> Result<File, Vec<Diagnostic>> {
+    if text.len() > MAX_FILE_BYTES {
+        return Err(vec![Diagnostic::error(
+            Code::Syntax,
+            format!(
+                "file is too large ({} bytes; the limit is {} bytes)",
+                text.len(),
+                MAX_FILE_BYTES
+            ),
+            Span::new(file, 0, 0),
+            "this file",
+        )
+        .with_help("split the plan set into smaller files")]);
+    }
+    check_nesting(file, text)?;
+    let pairs = match RcsParser::parse(Rule::file, text) {
+        Ok(mut pairs) => pairs.next().expect("the file rule always yields one pair"),
+        Err(e) => {
+            // Tracking every token tried costs time, so only a failed parse
+            // runs again with it, to say which punctuation was expected.
+            pest::set_error_detail(true);
+            let detailed = RcsParser::parse(Rule::file, text).err();
+            pest::set_error_detail(false);
+            return Err(vec![syntax_error(file, text, detailed.unwrap_or(e))]);
+        }
+    };
+    let mut builder = Builder {
+        file,
+        diags: Vec::new(),
+    };
+    let mut out = File::default();
+    for p in pairs.into_inner() {
+        if p.as_rule() == Rule::item {
+            if let Some(item) = builder.item(p) {
+                out.items.push(item);
+            }
+        }
+    }
+    if builder.diags.is_empty() {
+        Ok(out)
+    } else {
+        Err(builder.diags)
+    }
+}
+
+/// Reject bracket nesting deeper than [`MAX_NESTING`] before pest sees the
+/// text, skipping comments and strings the way the grammar does. An
+/// unterminated block comment or string is reported here too, in plain
+/// words, where pest could only point at an unexpected `/` or `"`.
+fn check_nesting(file: FileId, text: &str) -> Result<(), Vec<Diagnostic>> {
+    let bytes = text.as_bytes();
+    let mut depth = 0usize;
+    let mut i = 0;
+    while i < bytes.len() {
+        match bytes[i] {
+            b'/' if bytes.get(i + 1) == Some(&b'/') => {
+                while i < bytes.len() && bytes[i] != b'\n' {
+                    i += 1;
+                }
+            }
+            b'/' if bytes.get(i + 1) == Some(&b'*') => {
+                let start = i;
+                i += 2;
+                while i < bytes.len() && !(bytes[i] == b'*' && bytes.get(i + 1) == Some(&b'/')) {
+                    i += 1;
+                }
+                if i >= bytes.len() {
+                    // pest would only say that `/` is unexpected here.
+                    return Err(vec![Diagnostic::error(
+                        Code::Syntax,
+                        "unterminated block comment",
+                        Span::new(file, start, start + 2),
+                        "this comment is never closed",
+                    )
+                    .with_help("close it with `*/`; block comments do not nest")]);
+                }
+                i += 1;
+            }
+            b'"' => {
+                let start = i;
+                i += 1;
+                while i < bytes.len() && bytes[i] != b'"' && bytes[i] != b'\n' {
+                    if bytes[i] == b'\\' {
+                        i += 1;
+                    }
+                    i += 1;
+                }
+                if i >= bytes.len() || bytes[i] != b'"' {
+                    return Err(vec![Diagnostic::error(
+                        Code::Syntax,
+                        "unterminated string",
+                        Span::new(file, start, start + 1),
+                        "this string has no closing `\"` on its line",
+                    )
+                    .with_help("close the title with `\"`; strings cannot span lines")]);
+                }
+            }
+            b'(' | b'[' | b'{' => {
+                depth += 1;
+                if depth > MAX_NESTING {
+                    return Err(vec![Diagnostic::error(
+                        Code::Syntax,
+                        format!("brackets nested more than {MAX_NESTING} deep"),
+                        Span::new(file, i, i + 1),
+                        "nesting limit reached here",
+                    )
+                    .with_help("split the expression with a `var` or a hook")]);
+                }
+            }
+            b')' | b']' | b'}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+        i += 1;
+    }
+    Ok(())
+}

@@ -8,6 +8,7 @@ mod controller;
 mod driver;
 mod expr;
 mod names;
+mod plan;
 mod system;
 mod types;
 

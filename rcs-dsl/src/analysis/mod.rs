@@ -41,6 +41,8 @@
 
 pub mod domain;
 pub mod eval;
+pub mod path;
+pub mod run;
 pub mod search;
 pub mod terms;
 

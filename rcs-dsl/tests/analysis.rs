@@ -343,6 +343,29 @@ controller T {
     assert!(a.can_fire_in(0, StateId(1)).is_never());
 }
 
+/// Of two `otherwise` rows (an error, but the graph still asks), only the
+/// first fires, as on the interpreter.
+#[test]
+fn only_the_first_otherwise_fires() {
+    let text = "controller A {
+    command GO
+    var ready: bool = false
+    plan GO {
+        *0 when new_command -> S1
+        S1 when ready -> Done
+        otherwise -> same
+        otherwise -> S1
+    }
+}
+";
+    let set = rcs_dsl::PlanSet::from_texts("p", [("p.rcs", text)], None);
+    let ir = rcs_dsl::lower_unchecked(&set).expect("lowers");
+    let c = &ir.controllers[0];
+    let a = PlanAnalysis::new(&ir, c, &c.plans[0]);
+    assert!(matches!(a.can_fire_in(2, StateId(1)), Answer::Can(_)));
+    assert!(a.can_fire_in(3, StateId(1)).is_never());
+}
+
 /// Every `unhandled_error` stall the analysis proves in these plan sets is
 /// replayed on the interpreter: the library's path to the state (rows
 /// shown to fire, each replayed from its witness), then the stall's inputs

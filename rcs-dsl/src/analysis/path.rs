@@ -73,7 +73,7 @@ impl PlanAnalysis<'_> {
                     continue;
                 }
                 let expect = Expect::Fires {
-                    row: row.display_name(),
+                    row: super::run::row_name(row),
                     state: self.plan.states[to.index()].name.clone(),
                 };
                 for wait in self.waits(&scene, prefix.steps.is_empty()) {
@@ -119,6 +119,37 @@ impl PlanAnalysis<'_> {
     /// two arguments giving two results, a NaN) or the replay on the
     /// interpreter does not show `expect`.
     pub fn extend(
+        &self,
+        prefix: &Run,
+        witness: &Witness,
+        cycles: u32,
+        expect: Expect,
+    ) -> Option<Run> {
+        self.try_extend(prefix, witness, cycles, expect).ok()
+    }
+
+    /// [`extend`](Self::extend), saying why not: [`RunError::Unwritable`]
+    /// when a scenario cannot give the witness's inputs (or `prefix` does
+    /// not replay), [`RunError::Replay`] when it can but the interpreter
+    /// does not show `expect`.
+    pub fn try_extend(
+        &self,
+        prefix: &Run,
+        witness: &Witness,
+        cycles: u32,
+        expect: Expect,
+    ) -> Result<Run, RunError> {
+        let run = self
+            .step_run(prefix, witness, cycles, expect)
+            .ok_or(RunError::Unwritable)?;
+        let ctrl = self.ctrl_id().ok_or(RunError::Unwritable)?;
+        replay_on(self.ir, ctrl, &run).map_err(RunError::Replay)?;
+        Ok(run)
+    }
+
+    /// The run of [`try_extend`](Self::try_extend) before its replay;
+    /// `None` when a scenario cannot give the witness's inputs.
+    fn step_run(
         &self,
         prefix: &Run,
         witness: &Witness,
@@ -183,8 +214,15 @@ impl PlanAnalysis<'_> {
             }
         }
         run.steps.push(step);
-        replay_on(ir, self.ctrl_id()?, &run).ok()?;
         Some(run)
+    }
+
+    /// The leaves a scenario cannot set, pinned as `prefix` leaves them
+    /// after `wait` more cycles with nothing firing: what a witness of the
+    /// next step must agree with. `None` when `prefix` does not replay.
+    pub fn pins_after(&self, prefix: &Run, wait: u32) -> Option<Vec<(LeafId, Value)>> {
+        let scene = self.scene(prefix)?;
+        Some(self.pins(&scene, prefix, wait))
     }
 
     /// What the interpreter holds after `run`: a fresh controller for the
@@ -262,6 +300,8 @@ impl PlanAnalysis<'_> {
                     scene.params.get(p.index()).and_then(|v| at_path(v, steps))
                 }
                 Leaf::Var(v, steps) => scene.vars.get(v.index()).and_then(|v| at_path(v, steps)),
+                // A scenario writes every status each cycle: never stale.
+                Leaf::SubStale(_) => Some(Value::Int(0)),
                 Leaf::Buffer(b, steps) if !self.ctrl.reads.contains(b) => self
                     .ctrl
                     .writes
@@ -276,6 +316,17 @@ impl PlanAnalysis<'_> {
         }
         pins
     }
+}
+
+/// Why a witness did not become a step of a run.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RunError {
+    /// A scenario cannot give its inputs: a NaN or infinity, one hook with
+    /// two results in a cycle, a status inside a buffer; or the run before
+    /// it does not replay.
+    Unwritable,
+    /// The interpreter does not do what the step expects: what happened.
+    Replay(String),
 }
 
 /// What the interpreter holds at the end of a path.

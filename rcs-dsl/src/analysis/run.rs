@@ -284,3 +284,14 @@ pub fn json_of(ir: &Ir, ty: &Type, v: &Value) -> Option<Json> {
         _ => return None,
     })
 }
+
+/// A row as a run and a scenario name it: `E3`, `*2`, `otherwise` or
+/// `#4` (a `*N` by its position, which a misnumbered row's label is not).
+pub fn row_name(row: &crate::ir::Row) -> String {
+    match (&row.label, &row.from) {
+        (Some(n), _) => format!("E{n}"),
+        (None, crate::ir::From::DontCare(_)) => format!("*{}", row.position),
+        (None, _) if row.is_otherwise() => "otherwise".to_string(),
+        _ => format!("#{}", row.position),
+    }
+}

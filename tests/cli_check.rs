@@ -196,11 +196,14 @@ fn help_lists_examples() {
     assert!(text(&out.stdout).contains("rcsc check plans/submarine"));
 }
 
-/// The golden cases whose findings carry runs.
-const WITH_RUNS: [&str; 3] = [
+/// The golden cases whose findings carry runs: paths through several
+/// states, a wait for `state_cycles`, a command parameter and a var.
+const WITH_RUNS: [&str; 5] = [
     "tests/data/err/2911_unhandled_error_reference_submarine",
     "tests/data/err/2912_unhandled_error_status_test.rcs",
     "tests/data/err/2913_unhandled_error_one_of_two_subordinates.rcs",
+    "tests/data/err/2914_unhandled_error_after_a_wait.rcs",
+    "tests/data/err/2915_unhandled_error_with_parameter_and_var.rcs",
 ];
 
 #[test]
@@ -240,7 +243,7 @@ fn witnesses_are_scenarios_that_rcsc_test_passes() {
         );
         written += files.len();
     }
-    assert!(written >= 4, "only {written} witnesses");
+    assert!(written >= 6, "only {written} witnesses");
 }
 
 #[test]

@@ -37,28 +37,35 @@ controller A {
 }
 ";
 
-fn swing(rows: Vec<Firing>) -> Run {
+/// A run of `A.GO`: `entry` fires into S1 on the command's cycle, then
+/// `steps`.
+fn go_then(entry: &str, steps: Vec<RunStep>) -> Run {
+    let first = RunStep {
+        cycles: 1,
+        expect: Expect::Fires {
+            row: entry.into(),
+            state: "S1".into(),
+        },
+        ..RunStep::default()
+    };
     Run {
         controller: "A".into(),
         command: "GO".into(),
         params: BTreeMap::new(),
-        steps: vec![
-            RunStep {
-                cycles: 1,
-                expect: Expect::Fires {
-                    row: "E0".into(),
-                    state: "S1".into(),
-                },
-                ..RunStep::default()
-            },
-            RunStep {
-                reads: BTreeMap::from([("i".to_string(), json!({ "go": true }))]),
-                cycles: 6,
-                expect: Expect::Repeats { rows },
-                ..RunStep::default()
-            },
-        ],
+        steps: std::iter::once(first).chain(steps).collect(),
     }
+}
+
+fn swing(rows: Vec<Firing>) -> Run {
+    go_then(
+        "E0",
+        vec![RunStep {
+            reads: BTreeMap::from([("i".to_string(), json!({ "go": true }))]),
+            cycles: 6,
+            expect: Expect::Repeats { rows },
+            ..RunStep::default()
+        }],
+    )
 }
 
 #[test]
@@ -95,27 +102,15 @@ controller B {
 }
 ",
     );
-    let run = Run {
-        controller: "A".into(),
-        command: "GO".into(),
-        params: BTreeMap::new(),
-        steps: vec![
-            RunStep {
-                cycles: 1,
-                expect: Expect::Fires {
-                    row: "*0".into(),
-                    state: "S1".into(),
-                },
-                ..RunStep::default()
-            },
-            RunStep {
-                subordinates: BTreeMap::from([("B".to_string(), "EXECUTING".to_string())]),
-                cycles: 5,
-                ..RunStep::default()
-            }
-            .fires_each_cycle("E1".into(), "S1".into()),
-        ],
-    };
+    let run = go_then(
+        "*0",
+        vec![RunStep {
+            subordinates: BTreeMap::from([("B".to_string(), "EXECUTING".to_string())]),
+            cycles: 5,
+            ..RunStep::default()
+        }
+        .fires_each_cycle("E1".into(), "S1".into())],
+    );
     replay(&ir, CtrlId(0), &run).unwrap();
     let text = scenario_text(&run, "storm", "").unwrap();
     assert!(text.contains("'*0'") || text.contains("\"*0\""), "{text}");

@@ -165,3 +165,34 @@ fn what_a_scenario_cannot_write_is_refused() {
     run.controller = "Z".into();
     assert!(replay(&ir, CtrlId(0), &run).is_err());
 }
+
+#[test]
+fn a_path_fires_rows_that_stay_to_count_in_a_var() {
+    let ir = lower(
+        "controller A {
+    command GO
+    var count: u8 = 0
+    plan GO {
+        E0: *0 when new_command -> S1 { count = 0 }
+        E1: S1 when count >= 3 -> S2
+        E2: S1 when count < 3 -> same { count += 1 }
+        E3: S2 when state_cycles > 1 -> Done
+    }
+}
+",
+    );
+    let c = &ir.controllers[0];
+    let a = PlanAnalysis::new(&ir, c, &c.plans[0]);
+    let paths = a.paths();
+    let to_s2 = paths[2].as_ref().expect("S2 is reached by counting");
+    let rows: Vec<String> = to_s2
+        .steps
+        .iter()
+        .map(|s| match &s.expect {
+            Expect::Fires { row, .. } => row.clone(),
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    assert_eq!(rows, ["E0", "E2", "E2", "E2", "E1"]);
+    replay(&ir, CtrlId(0), to_s2).unwrap();
+}

@@ -11,7 +11,9 @@
 //! A row that needs a counter (`state_cycles > 5`) is reached by waiting:
 //! its witness's inputs held for the cycles before, in which no row may
 //! fire (the replay checks it; if another row fires, that wait is not
-//! offered).
+//! offered). A row that needs a var to change (`count >= 3`) is reached
+//! by firing rows that stay in the state and change vars, up to
+//! [`MAX_LOOPS`] times, before trying again.
 
 use super::run::{json_of, replay_on, Expect, Run, RunStep};
 use super::terms::{Leaf, LeafId, Step};
@@ -23,6 +25,9 @@ use std::collections::BTreeMap;
 
 /// The longest wait for a counter a path takes, in cycles.
 const MAX_WAIT: u32 = 1000;
+
+/// How many times a path fires rows that stay in a state to change vars.
+const MAX_LOOPS: usize = 32;
 
 impl PlanAnalysis<'_> {
     /// The id of the controller whose plan this is.
@@ -61,36 +66,85 @@ impl PlanAnalysis<'_> {
         paths[0] = Some(self.empty_run());
         let mut queue = std::collections::VecDeque::from([StateId::S0]);
         while let Some(at) = queue.pop_front() {
-            let Some(prefix) = paths[at.index()].clone() else {
+            let Some(mut prefix) = paths[at.index()].clone() else {
                 continue;
             };
-            let Some(scene) = self.scene(&prefix) else {
-                continue;
-            };
-            for (r, row) in self.plan.rows.iter().enumerate() {
-                let Target::State(to) = row.to else { continue };
-                if paths.get(to.index()).is_none_or(|p| p.is_some()) {
-                    continue;
-                }
-                let expect = Expect::Fires {
-                    row: super::run::row_name(row),
-                    state: self.plan.states[to.index()].name.clone(),
+            // Rows that stay in `at` and change vars can open the way out
+            // (`count += 1` until `count >= 3`): fire one, then try again.
+            for _ in 0..=MAX_LOOPS {
+                let Some(scene) = self.scene(&prefix) else {
+                    break;
                 };
-                for wait in self.waits(&scene, prefix.steps.is_empty()) {
-                    let mut pins = self.pins(&scene, &prefix, wait);
-                    pins.extend(given.iter().cloned());
-                    let Answer::Can(w) = self.can_fire_in_given(r, at, &pins) else {
+                for (r, row) in self.plan.rows.iter().enumerate() {
+                    let Target::State(to) = row.to else { continue };
+                    if paths.get(to.index()).is_none_or(|p| p.is_some()) {
                         continue;
-                    };
-                    if let Some(run) = self.extend(&prefix, &w, wait + 1, expect.clone()) {
+                    }
+                    if let Some(run) = self.fire_after(&prefix, &scene, r, at, to, given) {
                         paths[to.index()] = Some(run);
                         queue.push_back(to);
-                        break;
                     }
+                }
+                let open = self.plan.rows.iter().any(|row| {
+                    matches!(row.to, Target::State(to) if paths.get(to.index()).is_some_and(|p| p.is_none()))
+                });
+                match self.loop_once(&prefix, &scene, at, given) {
+                    Some(longer) if open => prefix = longer,
+                    _ => break,
                 }
             }
         }
         paths
+    }
+
+    /// `prefix`, then row `r` firing from `at` into `to` (after a wait for a
+    /// counter if it needs one).
+    fn fire_after(
+        &self,
+        prefix: &Run,
+        scene: &Scene,
+        r: usize,
+        at: StateId,
+        to: StateId,
+        given: &[(LeafId, Value)],
+    ) -> Option<Run> {
+        let expect = Expect::Fires {
+            row: super::run::row_name(&self.plan.rows[r]),
+            state: self.plan.states.get(to.index())?.name.clone(),
+        };
+        for wait in self.waits(scene, prefix.steps.is_empty()) {
+            let mut pins = self.pins(scene, prefix, wait);
+            pins.extend(given.iter().cloned());
+            let Answer::Can(w) = self.can_fire_in_given(r, at, &pins) else {
+                continue;
+            };
+            if let Some(run) = self.extend(prefix, &w, wait + 1, expect.clone()) {
+                return Some(run);
+            }
+        }
+        None
+    }
+
+    /// `prefix`, then one row that stays in `at` and changes a var; `None`
+    /// when no such row fires.
+    fn loop_once(
+        &self,
+        prefix: &Run,
+        scene: &Scene,
+        at: StateId,
+        given: &[(LeafId, Value)],
+    ) -> Option<Run> {
+        if prefix.steps.is_empty() {
+            return None; // S0 before the command: its first cycle is the entry's
+        }
+        self.plan.rows.iter().enumerate().find_map(|(r, row)| {
+            if !matches!(row.to, Target::Same) && row.to != Target::State(at) {
+                return None;
+            }
+            let run = self.fire_after(prefix, scene, r, at, at, given)?;
+            let after = self.scene(&run)?;
+            (after.vars != scene.vars).then_some(run)
+        })
     }
 
     /// A run that reaches `state` along `paths`, then holds `witness`'s

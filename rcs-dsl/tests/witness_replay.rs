@@ -40,6 +40,9 @@ fn cases() -> Vec<PathBuf> {
 #[derive(Default)]
 struct Counts {
     runs: usize,
+    /// States a path reaches, of all states.
+    reached: usize,
+    states: usize,
     fired: usize,
     unwritable: usize,
     failures: Vec<String>,
@@ -60,6 +63,8 @@ fn rows_fire(ir: &Ir, case: &str, counts: &mut Counts) {
         for p in &c.plans {
             let a = PlanAnalysis::new(ir, c, p);
             let paths = a.paths();
+            counts.states += paths.len();
+            counts.reached += paths.iter().filter(|p| p.is_some()).count();
             for (s, prefix) in paths.iter().enumerate() {
                 let Some(prefix) = prefix else { continue };
                 let state = StateId(s as u32);
@@ -148,10 +153,16 @@ fn every_witness_of_the_golden_corpus_replays() {
         counts.failures.join("\n")
     );
     eprintln!(
-        "{} runs of findings, {} rows fired from witnesses, {} witnesses a scenario cannot give",
-        counts.runs, counts.fired, counts.unwritable
+        "{} runs of findings; {} of {} states reached by a path; {} rows fired from \
+         witnesses, {} witnesses a scenario cannot give",
+        counts.runs, counts.reached, counts.states, counts.fired, counts.unwritable
     );
     assert!(counts.runs >= 6, "only {} runs replayed", counts.runs);
+    assert!(
+        counts.reached >= 450,
+        "only {} states reached by a path",
+        counts.reached
+    );
     assert!(
         counts.fired >= 300,
         "only {} witnesses replayed",

@@ -162,7 +162,7 @@ impl PlanAnalysis<'_> {
             return None;
         }
         let expect = Expect::Stays {
-            state: self.plan.states[state.index()].name.clone(),
+            state: self.plan.states.get(state.index())?.name.clone(),
         };
         self.extend(prefix, witness, cycles, expect)
     }

@@ -13,7 +13,7 @@
 //! fire (the replay checks it; if another row fires, that wait is not
 //! offered). A row that needs a var to change (`count >= 3`) is reached
 //! by firing rows that stay in the state and change vars, up to
-//! [`MAX_LOOPS`] times, before trying again.
+//! 32 times, before trying again.
 
 use super::run::{json_of, replay_on, Expect, Run, RunStep};
 use super::terms::{Leaf, LeafId, Step};

@@ -9,7 +9,7 @@
 //! One model serves every "can happen" lint: a hang or stall is a step
 //! where no row fires ([`Expect::Stays`]); an oscillation is a step where a
 //! sequence of rows fires over and over ([`Expect::Repeats`]); a command
-//! storm is the same with one row ([`Run::fires_each_cycle`]).
+//! storm is the same with one row ([`RunStep::fires_each_cycle`]).
 //!
 //! A run holds only what a scenario can set: `reads` buffers, hook results
 //! and subordinate statuses. Vars, counters and `new_command` follow from

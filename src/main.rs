@@ -13,6 +13,7 @@ use std::time::Instant;
 
 mod compiled;
 mod test_cmd;
+mod witnesses;
 
 #[derive(Parser)]
 #[command(
@@ -30,7 +31,7 @@ struct Cli {
 enum Command {
     /// Parse and validate plan sets; print diagnostics.
     #[command(
-        after_help = "Examples:\n  rcsc check plans/submarine\n  rcsc check plans/figure13/figure13.rcs --message-format short\n  rcsc check . -D unused -A float_equality"
+        after_help = "Examples:\n  rcsc check plans/submarine\n  rcsc check plans/figure13/figure13.rcs --message-format short\n  rcsc check . -D unused -A float_equality\n  rcsc check plans/submarine --witnesses target/witnesses && rcsc test plans/submarine target/witnesses/*.scenario.yaml"
     )]
     Check(CheckArgs),
     /// Check plan sets, then write their state graphs, state tables and Rust code.
@@ -155,6 +156,10 @@ Examples:
 struct CheckArgs {
     /// Plan-set folders (using their rcs.yaml) or .rcs files [default: .]
     paths: Vec<PathBuf>,
+    /// Write a scenario per finding that has a run (a way to reproduce it)
+    /// under DIR: `<lint>_<controller>_<plan>_<state>.scenario.yaml`.
+    #[arg(long, value_name = "DIR")]
+    witnesses: Option<PathBuf>,
     #[command(flatten)]
     common: Common,
 }
@@ -344,7 +349,7 @@ fn test(args: TestArgs) -> ExitCode {
         Ok(p) => p,
         Err(reason) => return fail(reason),
     };
-    let irs = match check_sets(&sets, &args.common, false, None) {
+    let irs = match check_sets(&sets, &args.common, false, None, None) {
         Ok(irs) => irs,
         Err(code) => return code,
     };
@@ -514,7 +519,22 @@ fn check(args: CheckArgs) -> ExitCode {
         Ok(sets) => sets,
         Err(e) => return fail(e),
     };
-    match check_sets(&sets, &args.common, false, None) {
+    let mut found = witnesses::Witnesses::default();
+    let gather = args.witnesses.is_some().then_some(&mut found);
+    let result = check_sets(&sets, &args.common, false, None, gather);
+    if let Some(dir) = &args.witnesses {
+        if let Err(reason) = found.write(dir) {
+            return fail(reason);
+        }
+        if args.common.format() != Format::Json && !args.common.quiet {
+            eprintln!(
+                "wrote {} to {}",
+                plural(found.len(), "witness scenario"),
+                rcs_dsl::load::display(dir)
+            );
+        }
+    }
+    match result {
         Ok(_) => ExitCode::SUCCESS,
         Err(code) => code,
     }
@@ -522,12 +542,14 @@ fn check(args: CheckArgs) -> ExitCode {
 
 /// Check every plan set, printing diagnostics (JSON to stdout unless
 /// `stdout_busy`) and the summary line; with `status`, a `Checking` line
-/// per set. `Err` is exit status 1 when any set has an error.
+/// per set; with `witnesses`, the runs of the findings gathered. `Err` is
+/// exit status 1 when any set has an error.
 fn check_sets(
     sets: &[rcs_dsl::PlanSet],
     common: &Common,
     stdout_busy: bool,
     status: Option<&Status>,
+    mut witnesses: Option<&mut witnesses::Witnesses>,
 ) -> Result<Vec<rcs_dsl::ir::Ir>, ExitCode> {
     let options = common.options();
     let mut counts = Counts::default();
@@ -545,6 +567,9 @@ fn check_sets(
         }
         let checked = rcs_dsl::check(set, &options);
         print_diagnostics(set, &checked, common, stdout_busy, &mut counts);
+        if let Some(w) = witnesses.as_deref_mut() {
+            w.collect(&checked);
+        }
         irs.extend(checked.ir);
     }
     print_summary(common, &counts);
@@ -599,7 +624,7 @@ fn build(args: BuildArgs) -> ExitCode {
         Err(e) => return fail(e),
     };
     // Check everything before writing anything.
-    let irs = match check_sets(&sets, &args.common, false, Some(&status)) {
+    let irs = match check_sets(&sets, &args.common, false, Some(&status), None) {
         Ok(irs) => irs,
         Err(code) => return code,
     };
@@ -651,7 +676,7 @@ fn checked_irs(
     common: &Common,
 ) -> Result<Vec<(rcs_dsl::PlanSet, rcs_dsl::ir::Ir)>, ExitCode> {
     let sets = rcs_dsl::load_paths(&default_paths(paths)).map_err(fail)?;
-    let irs = check_sets(&sets, common, true, None)?;
+    let irs = check_sets(&sets, common, true, None, None)?;
     Ok(sets.into_iter().zip(irs).collect())
 }
 

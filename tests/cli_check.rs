@@ -195,3 +195,85 @@ fn help_lists_examples() {
     assert_eq!(out.status.code(), Some(0));
     assert!(text(&out.stdout).contains("rcsc check plans/submarine"));
 }
+
+/// The golden cases whose findings carry runs: paths through several
+/// states, a wait for `state_cycles`, a command parameter and a var.
+const WITH_RUNS: [&str; 5] = [
+    "tests/data/err/2911_unhandled_error_reference_submarine",
+    "tests/data/err/2912_unhandled_error_status_test.rcs",
+    "tests/data/err/2913_unhandled_error_one_of_two_subordinates.rcs",
+    "tests/data/err/2914_unhandled_error_after_a_wait.rcs",
+    "tests/data/err/2915_unhandled_error_with_parameter_and_var.rcs",
+];
+
+#[test]
+fn witnesses_are_scenarios_that_rcsc_test_passes() {
+    let mut written = 0;
+    for (i, case) in WITH_RUNS.iter().enumerate() {
+        let dir = scratch(&format!("witnesses{i}"), &[]);
+        let out = rcsc(&["check", case, "--witnesses", dir.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(0), "{case}: {}", text(&out.stderr));
+        assert!(text(&out.stderr).contains("witness scenario"), "{case}");
+        let mut files: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path().to_string_lossy().into_owned())
+            .collect();
+        files.sort();
+        assert!(!files.is_empty(), "{case}: no witness written");
+        for f in &files {
+            let name = Path::new(f).file_name().unwrap().to_string_lossy();
+            assert!(
+                name.starts_with("unhandled_error_") && name.ends_with(".scenario.yaml"),
+                "{name}"
+            );
+        }
+        // The same check writes the same files.
+        let again = scratch(&format!("witnesses{i}again"), &[]);
+        rcsc(&["check", case, "--witnesses", again.to_str().unwrap()]);
+        assert_eq!(common::tree(&dir), common::tree(&again), "{case}");
+        let mut args = vec!["test", case];
+        args.extend(files.iter().map(String::as_str));
+        let out = rcsc(&args);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{case}: {}{}",
+            text(&out.stdout),
+            text(&out.stderr)
+        );
+        written += files.len();
+    }
+    assert!(written >= 6, "only {written} witnesses");
+}
+
+#[test]
+fn json_findings_carry_their_run() {
+    let out = rcsc(&["check", WITH_RUNS[2], "--message-format", "json"]);
+    let stdout = text(&out.stdout);
+    let v: serde_json::Value = serde_json::from_str(stdout.lines().next().unwrap()).unwrap();
+    assert_eq!(v["code"], "unhandled_error");
+    let run = &v["witness"]["run"];
+    assert_eq!(run["controller"], "C");
+    assert_eq!(run["command"], "GO");
+    let steps = run["steps"].as_array().unwrap();
+    let last = steps.last().unwrap();
+    assert_eq!(last["cycles"], 30);
+    assert_eq!(last["expect"]["kind"], "stays");
+    assert_eq!(last["subordinates"]["D"], "ERROR");
+}
+
+#[test]
+fn an_unwritable_witnesses_folder_exits_2() {
+    let dir = scratch("witnesses-file", &[("taken", "not a folder\n")]);
+    let target = dir.join("taken");
+    let out = rcsc(&[
+        "check",
+        WITH_RUNS[1],
+        "--witnesses",
+        target.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = text(&out.stderr);
+    assert!(stderr.contains("error: cannot write"), "{stderr}");
+    assert!(stderr.contains("taken"), "{stderr}");
+}

@@ -201,3 +201,64 @@ fn every_code_has_two_err_cases() {
         thin.join(", ")
     );
 }
+
+/// The analysis of conditions is exercised in depth: at least three
+/// failing cases for each kind of finding it makes (named by the case's
+/// file name), and at least thirty clean plans built around its traps
+/// (`ok/01NN_analysis_*`: wrapping, NaN gaps, opaque terms, open statuses…)
+/// that must produce no finding at all.
+#[test]
+fn the_analysis_has_three_err_cases_per_class_and_thirty_clean_plans() {
+    const CLASSES: [(&str, &str); 15] = [
+        ("shadowed by implication", "shadowed_row_by_implication"),
+        ("shadowed by a union of rows", "shadowed_row_by_union"),
+        ("shadowed by preceding *N rows", "shadowed_row_by_dont_care"),
+        (
+            "shadowed by enum exhaustion",
+            "shadowed_row_by_enum_exhaustion",
+        ),
+        (
+            "shadowed by status exhaustion",
+            "shadowed_row_by_status_exhaustion",
+        ),
+        (
+            "shadowed by boolean structure",
+            "shadowed_row_by_boolean_structure",
+        ),
+        (
+            "shadowed by integer ranges",
+            "shadowed_row_by_integer_ranges",
+        ),
+        ("shadowed by type bounds", "shadowed_row_by_type_bounds"),
+        ("unreachable row, unsatisfiable", "unreachable_row_"),
+        ("unreachable row, type bound", "unreachable_row_type_bound"),
+        ("dead end behind dead rows", "dead_end_state_"),
+        (
+            "unreachable state behind dead rows",
+            "unreachable_state_behind",
+        ),
+        (
+            "unreachable state, target of a dead row",
+            "unreachable_state_",
+        ),
+        ("no_done via dead rows", "no_done_"),
+        ("unhandled_error", "unhandled_error_"),
+    ];
+    let names: Vec<String> = cases("err").iter().map(|c| case_name(c)).collect();
+    let thin: Vec<String> = CLASSES
+        .iter()
+        .map(|(what, part)| (what, names.iter().filter(|n| n.contains(part)).count()))
+        .filter(|(_, n)| *n < 3)
+        .map(|(what, n)| format!("{what} ({n})"))
+        .collect();
+    assert!(
+        thin.is_empty(),
+        "classes with fewer than three err cases: {}",
+        thin.join(", ")
+    );
+    let clean = cases("ok")
+        .iter()
+        .filter(|c| case_name(c).contains("_analysis_"))
+        .count();
+    assert!(clean >= 30, "only {clean} clean analysis plans in ok/");
+}

@@ -183,6 +183,11 @@ pub struct Diagnostic {
 pub struct Witness {
     pub state: String,
     pub inputs: Vec<WitnessInput>,
+    /// The same finding reproduced from a fresh controller, step by step,
+    /// when one was found and replayed (what `rcsc check --witnesses`
+    /// writes as a scenario).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub run: Option<crate::analysis::run::Run>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -256,7 +261,17 @@ impl Diagnostic {
                     value: value.clone(),
                 })
                 .collect(),
+            run: None,
         });
+        self
+    }
+
+    /// The run that reproduces the finding, on its witness (set by
+    /// [`Diagnostic::with_witness`] first).
+    pub fn with_run(mut self, run: Option<crate::analysis::run::Run>) -> Self {
+        if let Some(w) = &mut self.witness {
+            w.run = run;
+        }
         self
     }
 

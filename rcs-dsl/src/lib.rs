@@ -7,6 +7,10 @@
 //!                                                               (asking analysis)
 //! ```
 //!
+//! A finding that something can happen carries a witness, and where a path
+//! to it is found a run ([`analysis::run`]): replayed on the interpreter,
+//! written as a scenario by `rcsc check --witnesses`.
+//!
 //! [`check`] runs it. Each stage reports all of its errors and the pipeline
 //! stops after a stage that found any, so one mistake gives one diagnostic.
 //! The IR is returned only when no error was found; it is the input of the

@@ -805,7 +805,8 @@ fn plan_of<'c>(c: &'c Controller, rec: &Record) -> Option<&'c Plan> {
 fn fired_name(c: &Controller, rec: &Record, row: u16) -> String {
     plan_of(c, rec)
         .and_then(|p| p.rows.get(usize::from(row)))
-        .map(|r| r.display_name())
+        // The name `fired:` accepts, even for a misnumbered `*N` row.
+        .map(crate::analysis::run::row_name)
         .unwrap_or_else(|| format!("#{row}"))
 }
 

@@ -343,55 +343,37 @@ controller T {
     assert!(a.can_fire_in(0, StateId(1)).is_never());
 }
 
-/// One cycle's inputs from a witness, applied through the driver: reads
-/// buffer fields, hook results, subordinate statuses (echoing the last
-/// command sent to them). Vars and counters are not inputs a driver sets;
-/// the witnesses replayed here do not ask for them.
-fn apply_witness(ir: &Ir, c: CtrlId, d: &mut interp::Driven, reads: &mut [Value], w: &Witness) {
-    use rcs_runtime::{Status, StatusBuffer};
-    let ctrl = ir.controller(c);
-    for (leaf, v) in &w.inputs {
-        match leaf {
-            Leaf::NewCommand | Leaf::StateCycles | Leaf::PlanCycles | Leaf::Param(..) => {}
-            Leaf::SubStatus(x) => {
-                let name = &ir.controller(*x).name;
-                let Value::Status(s) = v else { panic!("{v:?}") };
-                let serial = d.last_sent(name).unwrap();
-                let status = StatusBuffer {
-                    echo_serial: serial,
-                    status: Status(*s),
-                    ..StatusBuffer::default()
-                };
-                d.write_sub_status(name, status).unwrap();
-            }
-            Leaf::Buffer(b, steps) => {
-                let i = ctrl
-                    .reads
-                    .iter()
-                    .position(|r| r == b)
-                    .expect("a reads buffer");
-                let [Step::Field(f)] = steps.as_slice() else {
-                    panic!("{steps:?}")
-                };
-                if let Value::Buffer(fields) = &mut reads[i] {
-                    fields[*f as usize] = v.clone();
-                }
-                let name = &ir.buffers[b.index()].name;
-                d.set_read(name, &reads[i]).unwrap();
-            }
-            Leaf::Call(h, _) => d.set_hook(&ctrl.hooks[h.index()].name, v).unwrap(),
-            other => panic!("a witness the driver cannot replay: {other:?}"),
-        }
+/// Of two `otherwise` rows (an error, but the graph still asks), only the
+/// first fires, as on the interpreter.
+#[test]
+fn only_the_first_otherwise_fires() {
+    let text = "controller A {
+    command GO
+    var ready: bool = false
+    plan GO {
+        *0 when new_command -> S1
+        S1 when ready -> Done
+        otherwise -> same
+        otherwise -> S1
     }
+}
+";
+    let set = rcs_dsl::PlanSet::from_texts("p", [("p.rcs", text)], None);
+    let ir = rcs_dsl::lower_unchecked(&set).expect("lowers");
+    let c = &ir.controllers[0];
+    let a = PlanAnalysis::new(&ir, c, &c.plans[0]);
+    assert!(matches!(a.can_fire_in(2, StateId(1)), Answer::Can(_)));
+    assert!(a.can_fire_in(3, StateId(1)).is_never());
 }
 
 /// Every `unhandled_error` stall the analysis proves in these plan sets is
-/// replayed on the interpreter: reach the state along rows the analysis
-/// shows can fire (each replayed from its witness), then give the stall's
-/// inputs (the subordinate in ERROR) and run: no row fires, the plan stays.
+/// replayed on the interpreter: the library's path to the state (rows
+/// shown to fire, each replayed from its witness), then the stall's inputs
+/// (the subordinate in ERROR) for 30 cycles: no row fires, the plan stays.
 #[test]
 fn stall_witnesses_hold_on_the_interpreter() {
-    use rcs_dsl::ir::{StatusId, Target};
+    use rcs_dsl::analysis::run::replay;
+    use rcs_dsl::ir::StatusId;
     let mut stalls = 0;
     for case in [
         "../tests/data/err/2911_unhandled_error_reference_submarine",
@@ -404,76 +386,18 @@ fn stall_witnesses_hold_on_the_interpreter() {
             let cid = CtrlId(ci as u32);
             for p in &c.plans {
                 let a = PlanAnalysis::new(&ir, c, p);
+                let paths = a.paths();
                 for s in 0..p.states.len() {
                     let state = StateId(s as u32);
                     for &x in &c.subordinates {
                         let Some(stall) = a.stalls_in(state, x, StatusId::ERROR) else {
                             continue;
                         };
-                        // A shortest path of rows from S0 to `state`, each
-                        // shown to fire by its witness.
-                        let mut paths: Vec<Option<Vec<(usize, Witness)>>> =
-                            vec![None; p.states.len()];
-                        paths[0] = Some(Vec::new());
-                        let mut queue = std::collections::VecDeque::from([StateId::S0]);
-                        while let Some(at) = queue.pop_front() {
-                            for r in 0..p.rows.len() {
-                                let (Target::State(t), Answer::Can(w)) =
-                                    (p.rows[r].to, a.can_fire_in(r, at))
-                                else {
-                                    continue;
-                                };
-                                if paths[t.index()].is_none() {
-                                    let mut path = paths[at.index()].clone().unwrap();
-                                    path.push((r, w));
-                                    paths[t.index()] = Some(path);
-                                    queue.push_back(t);
-                                }
-                            }
-                        }
-                        let Some(path) = paths[s].clone() else {
+                        let Some(run) = a.stall_run(&paths, state, &stall, 30) else {
                             continue;
                         };
-                        let verb = &c.commands[p.verb.index()];
-                        let args: Vec<Value> = verb
-                            .params
-                            .iter()
-                            .map(|q| interp::zero(&ir, &q.ty))
-                            .collect();
-                        let mut d = interp::Driven::new(&ir, cid);
-                        let mut reads: Vec<Value> = c
-                            .reads
-                            .iter()
-                            .map(|b| {
-                                interp::zero(
-                                    &ir,
-                                    &rcs_dsl::ir::Type::Buffer(ir.buffers[b.index()].ty),
-                                )
-                            })
-                            .collect();
-                        d.command(&verb.name, &args).unwrap();
-                        for (r, w) in &path {
-                            apply_witness(&ir, cid, &mut d, &mut reads, w);
-                            let rec = d.cycle();
-                            assert_eq!(
-                                rec.fired,
-                                Some(*r as u16),
-                                "{case}: step {} of the path to {}",
-                                w.text(),
-                                p.states[s].name
-                            );
-                        }
-                        apply_witness(&ir, cid, &mut d, &mut reads, &stall);
-                        for _ in 0..30 {
-                            let rec = d.cycle();
-                            assert_eq!(
-                                rec.fired,
-                                None,
-                                "{case}: the stall in {} ({}) is left",
-                                p.states[s].name,
-                                stall.text()
-                            );
-                            assert_eq!(rec.state, s as u16);
+                        if let Err(e) = replay(&ir, cid, &run) {
+                            panic!("{case}: the stall in {}: {e}", p.states[s].name);
                         }
                         stalls += 1;
                     }

@@ -41,6 +41,8 @@
 
 pub mod domain;
 pub mod eval;
+pub mod path;
+pub mod run;
 pub mod search;
 pub mod terms;
 
@@ -362,6 +364,11 @@ impl<'ir> PlanAnalysis<'ir> {
             Some(c) => {
                 parts.push(Formula::Shared(c.clone()));
                 (0..row).collect()
+            }
+            // Only the first `otherwise` can fire (a second one is an
+            // error, `otherwise_not_last`, but the graph still asks).
+            None if self.plan.rows[..row].iter().any(|r| r.is_otherwise()) => {
+                return Some(Formula::Const(false));
             }
             None => (0..self.plan.rows.len()).filter(|i| *i != row).collect(),
         };

@@ -8,6 +8,7 @@
 //! no longer hides a dead end); `same` never leaves a state.
 
 use super::Sink;
+use crate::analysis::terms::Leaf;
 use crate::analysis::PlanAnalysis;
 use crate::diagnostic::Diagnostic;
 use crate::ir::{Controller, Ir, Plan, StateId, Target};
@@ -25,6 +26,10 @@ pub(crate) struct Analysis {
     pub ends: bool,
     /// Per row: proved unable to match by its own `from` and condition.
     pub never_matches: Vec<bool>,
+    /// A row that can fire leads back to `S0` from another reachable
+    /// state, and no row can leave `S0` then: every exit of `S0` needs
+    /// the new command, which only the entry has.
+    pub s0_dead_on_return: bool,
 }
 
 pub(crate) fn analyse(p: &Plan, conditions: &PlanAnalysis) -> Analysis {
@@ -66,12 +71,45 @@ pub(crate) fn analyse(p: &Plan, conditions: &PlanAnalysis) -> Analysis {
         .map(|s| g.neighbors(NodeIndex::new(s)).next().is_some())
         .collect();
     reachable.truncate(n);
+    let s0_dead_on_return = returns_to_s0(p, conditions, &reachable, &never_matches)
+        && !leaves_s0_without_command(p, conditions, &never_matches);
     Analysis {
         reachable,
         leaves,
         ends,
         never_matches,
+        s0_dead_on_return,
     }
+}
+
+/// Whether a row that can fire leads to `S0` from another reachable state.
+fn returns_to_s0(
+    p: &Plan,
+    conditions: &PlanAnalysis,
+    reachable: &[bool],
+    never_matches: &[bool],
+) -> bool {
+    p.rows.iter().enumerate().any(|(i, row)| {
+        row.to == Target::State(StateId::S0)
+            && !never_matches[i]
+            && (1..p.states.len())
+                .any(|f| reachable[f] && !conditions.never_fires_in(i, StateId(f as u32)))
+    })
+}
+
+/// Whether some row can leave `S0` on a cycle without a new command.
+fn leaves_s0_without_command(p: &Plan, conditions: &PlanAnalysis, never_matches: &[bool]) -> bool {
+    let Some(nc) = conditions.terms().find(&Leaf::NewCommand) else {
+        return true;
+    };
+    let no_command = [(nc, rcs_runtime::driver::Value::Bool(false))];
+    p.rows.iter().enumerate().any(|(i, row)| {
+        !never_matches[i]
+            && !matches!(row.to, Target::Same | Target::State(StateId::S0))
+            && !conditions
+                .can_fire_in_given(i, StateId::S0, &no_command)
+                .is_never()
+    })
 }
 
 pub(crate) fn check_unreachable_states(c: &Controller, p: &Plan, a: &Analysis, sink: &mut Sink) {
@@ -101,7 +139,8 @@ pub(crate) fn check_unreachable_states(c: &Controller, p: &Plan, a: &Analysis, s
 pub(crate) fn check_dead_ends(c: &Controller, p: &Plan, a: &Analysis, sink: &mut Sink) {
     let has_entry = p.rows.iter().any(|r| r.is_entry);
     for (i, s) in p.states.iter().enumerate() {
-        if a.leaves[i] || !a.reachable[i] || (i == 0 && !has_entry) {
+        let dead = !a.leaves[i] || (i == 0 && a.s0_dead_on_return);
+        if !dead || !a.reachable[i] || (i == 0 && !has_entry) {
             continue;
         }
         let span = s.span.unwrap_or(p.header);
@@ -112,7 +151,11 @@ pub(crate) fn check_dead_ends(c: &Controller, p: &Plan, a: &Analysis, sink: &mut
                 Lint::DeadEndState,
                 format!("state `{}` of plan `{}` has no way out", s.name, c.commands[p.verb.index()].name),
                 span,
-                "no row leaves this state",
+                if a.leaves[i] {
+                    "rows lead back here, and only a new command leaves"
+                } else {
+                    "no row leaves this state"
+                },
             )
             .with_note("only a new command can end the plan here")
             .with_help("add a row from this state to another state, `Done` or `Error(…)`; a continuous plan can `#[allow(dead_end_state)]`"),

@@ -3,7 +3,8 @@
 //! fire once X reports `ERROR`, although the plan X runs for it can end in
 //! `Error`. Each finding is proved by the analysis of conditions and
 //! carries a witness: a cycle, with `X.status = ERROR`, in which no row of
-//! that state matches.
+//! that state matches, and where a path to the state is found, a run: the
+//! path, then 30 cycles with X in `ERROR` and no row firing.
 
 use super::graph::Analysis;
 use super::Sink;
@@ -14,6 +15,10 @@ use crate::ir::{
     CommandId, CtrlId, Expr, ExprKind, From, Ir, Job, Row, StateId, StatusId, SubProp, Target,
 };
 use crate::lint::Lint;
+
+/// How long a stall's run holds the subordinate in `ERROR`: long enough
+/// to pass any timeout a reader would expect to have fired.
+const STALL_CYCLES: u32 = 30;
 
 /// Per controller, per plan: the analysis of its conditions and its graph.
 pub(crate) struct Plans<'a> {
@@ -26,6 +31,8 @@ pub(crate) fn check_unhandled_error(ir: &Ir, plans: &Plans, sink: &mut Sink) {
         for (pi, p) in c.plans.iter().enumerate() {
             let conditions = &plans.conditions[ci][pi];
             let graph = &plans.graphs[ci][pi];
+            // Paths to each state, searched once a finding needs one.
+            let paths = std::cell::OnceCell::new();
             for &x in &c.subordinates {
                 // The verbs this plan sends X, and a row of X's plans for
                 // them that can end in Error.
@@ -47,6 +54,8 @@ pub(crate) fn check_unhandled_error(ir: &Ir, plans: &Plans, sink: &mut Sink) {
                     let Some(w) = conditions.stalls_in(state, x, StatusId::ERROR) else {
                         continue;
                     };
+                    let paths = paths.get_or_init(|| conditions.paths());
+                    let run = conditions.stall_run(paths, state, &w, STALL_CYCLES);
                     let sub = &ir.controller(x).name;
                     let state_name = &p.states[s].name;
                     let verb = &c.commands[p.verb.index()].name;
@@ -68,6 +77,7 @@ pub(crate) fn check_unhandled_error(ir: &Ir, plans: &Plans, sink: &mut Sink) {
                         format!("`{sub}`'s plan `{x_verb}` can end in `Error` here"),
                     )
                     .with_witness(state_name, &w.shown)
+                    .with_run(run)
                     .with_note(format!(
                         "with `{sub}.status == ERROR` no row of `{state_name}` matches, whatever \
                          the other inputs: `{}` stays in `{state_name}` until a new command",

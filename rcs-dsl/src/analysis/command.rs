@@ -42,6 +42,10 @@ use rcs_runtime::driver::Value;
 /// tried; past it, the command analysis says nothing.
 pub const MAX_CASES: usize = 128;
 
+/// The most questions (cases × states × rows) one walk of all cases may
+/// ask; past it, nothing is said either, so that a large plan stays quick.
+pub const MAX_QUESTIONS: usize = 20_000;
+
 /// Values pinned for a whole command: leaf, value.
 pub type Case = Vec<(LeafId, Value)>;
 
@@ -69,6 +73,10 @@ pub struct Hang {
     /// Every case with which the plan surely reaches `state` and hangs
     /// there, `command` first.
     pub cases: Vec<Case>,
+    /// No row on the path reads a parameter through an opaque atom, so
+    /// each case's path holds for every value of its cells (else only for
+    /// the representative values themselves).
+    pub path_by_cells: bool,
 }
 
 /// A row that can match on its own but not with any command values its
@@ -105,7 +113,8 @@ struct Edge {
 impl PlanAnalysis<'_> {
     /// The cases of the values fixed for a command: every combination of
     /// one cell per parameter the conditions read. `None` when there are
-    /// too many, or a parameter has no cells (not a scalar).
+    /// too many (cases, or questions to ask about them), or a parameter
+    /// has no cells (not a scalar).
     pub fn command_cases(&self) -> Option<Vec<Case>> {
         let leaves = self.command_leaves();
         let mut cases: Vec<Case> = vec![Vec::new()];
@@ -133,7 +142,8 @@ impl PlanAnalysis<'_> {
                 })
                 .collect();
         }
-        Some(cases)
+        let questions = cases.len() * (self.plan.states.len() + 1) * self.plan.rows.len();
+        (questions <= MAX_QUESTIONS).then_some(cases)
     }
 
     /// Every state in which the plan hangs for some case, with the first
@@ -179,6 +189,7 @@ impl PlanAnalysis<'_> {
                     given: given.clone(),
                     path: path.clone(),
                     cases: Vec::new(),
+                    path_by_cells: self.path_by_cells(path, n),
                 });
                 hang.cases.push(case.clone());
             }
@@ -357,6 +368,31 @@ impl PlanAnalysis<'_> {
             }
         }
         paths
+    }
+
+    /// Whether no row on `path` reads a command parameter through an
+    /// opaque atom (one the proof cannot split into cells).
+    fn path_by_cells(&self, path: &[Step], n: usize) -> bool {
+        let mut by_cells = true;
+        let mut node = 0;
+        for step in path {
+            let Step::Fire { row, .. } = step else {
+                node = n;
+                continue;
+            };
+            if let Some(f) = self.fires(*row, node_state(node, n)) {
+                f.visit_atoms(&mut |a| {
+                    let atom = &self.terms.atoms[a];
+                    by_cells &= atom.exact
+                        || !atom
+                            .leaves
+                            .iter()
+                            .any(|&l| matches!(self.terms.leaves[l].0, Leaf::Param(..)));
+                });
+            }
+            node = target_node(node, n, self.plan.rows[*row].to).unwrap_or(node);
+        }
+        by_cells
     }
 
     /// Whether `f` reads an input the world does not set freely on any

@@ -39,7 +39,15 @@ pub(crate) fn check_incomplete_states(
             .cloned()
             .collect();
         // One parameter tells the cases apart: all of them, as ranges.
-        let values = if hang.command.len() == 1 && read_params.len() == 1 {
+        let values = if !hang.path_by_cells {
+            // The path was shown for these very values only.
+            let shown: Vec<String> = conditions
+                .case_shown(&read_params)
+                .into_iter()
+                .map(|(n, v)| format!("{n} = {v}"))
+                .collect();
+            shown.join(", ")
+        } else if hang.command.len() == 1 && read_params.len() == 1 {
             conditions.cases_text(&hang.cases)
         } else {
             conditions.case_text(&read_params)

@@ -304,3 +304,221 @@ fn rows_entered_only_with_other_values_never_fire() {
         assert!(rows > 0, "{case}: no row found");
     }
 }
+
+/// Random plans over four states, for the property test below: conditions
+/// on the command's parameters, a var no job assigns, a var some jobs
+/// assign, buffer fields, a hook, a subordinate's status, a counter and an
+/// opaque comparison; rows between states, `same`, `Done` and `Error`.
+mod random_plans {
+    use proptest::prelude::*;
+
+    pub const HEADER: &str = "enum Mode { A, B, C }
+buffer In { b0: bool, b1: bool, i: i8 }
+controller Q { command RUN plan RUN { *0 when new_command -> Done } }
+controller P {
+    subordinates Q
+    command GO(p: i16, m: Mode)
+    reads s: In
+    var k: bool = false
+    var w: i8 = 0
+    hook g() -> bool
+";
+
+    fn atom() -> impl Strategy<Value = String> {
+        let op = || prop::sample::select(vec!["==", "!=", "<", "<=", ">", ">="]);
+        let mode = || prop::sample::select(vec!["Mode::A", "Mode::B", "Mode::C"]);
+        prop_oneof![
+            Just("s.b0".to_string()),
+            Just("s.b1".to_string()),
+            Just("g()".to_string()),
+            Just("k".to_string()),
+            Just("w > 0".to_string()),
+            Just("Q.done".to_string()),
+            Just("Q.error".to_string()),
+            Just("state_cycles > 3".to_string()),
+            Just("cmd.p + 1 > s.i as i16".to_string()),
+            (op(), -2i32..=2).prop_map(|(o, k)| format!("s.i {o} {k}")),
+            (op(), -2i32..=2).prop_map(|(o, k)| format!("cmd.p {o} {k}")),
+            (op(), -2i32..=2).prop_map(|(o, k)| format!("cmd.p {o} {k}")),
+            (prop::bool::ANY, mode())
+                .prop_map(|(eq, m)| format!("cmd.m {} {m}", if eq { "==" } else { "!=" })),
+            (prop::bool::ANY, mode())
+                .prop_map(|(eq, m)| format!("cmd.m {} {m}", if eq { "==" } else { "!=" })),
+        ]
+    }
+
+    fn condition() -> impl Strategy<Value = String> {
+        atom().prop_recursive(2, 4, 2, |inner| {
+            prop_oneof![
+                inner.clone().prop_map(|c| format!("!({c})")),
+                (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("({a} && {b})")),
+                (inner.clone(), inner).prop_map(|(a, b)| format!("({a} || {b})")),
+            ]
+        })
+    }
+
+    fn target() -> impl Strategy<Value = String> {
+        prop::sample::select(vec![
+            "S0", "S1", "S2", "S3", "same", "Done", "Error", "S1", "S2",
+        ])
+        .prop_map(str::to_string)
+    }
+
+    fn jobs() -> impl Strategy<Value = String> {
+        prop::sample::select(vec!["", "", " { w = 1 }", " { w = 0 }", " { Q <- RUN }"])
+            .prop_map(str::to_string)
+    }
+
+    pub fn plan() -> impl Strategy<Value = String> {
+        (
+            prop::collection::vec((condition(), target(), jobs()), 1..=2),
+            prop::collection::vec(
+                (
+                    prop::sample::select(vec!["*", "S0", "S1", "S1", "S2", "S2", "S3"]),
+                    condition(),
+                    target(),
+                    jobs(),
+                ),
+                2..=7,
+            ),
+            prop::bool::weighted(0.15),
+        )
+            .prop_map(|(entries, rows, otherwise)| {
+                let mut text = String::from(HEADER);
+                text.push_str("    plan GO {\n");
+                for (c, t, j) in &entries {
+                    text.push_str(&format!("        * when new_command && {c} -> {t}{j}\n"));
+                }
+                for (from, c, t, j) in &rows {
+                    text.push_str(&format!("        {from} when {c} -> {t}{j}\n"));
+                }
+                if otherwise {
+                    text.push_str("        otherwise -> same\n");
+                }
+                text.push_str("    }\n}\n");
+                text
+            })
+    }
+}
+
+/// Replay hang `hang` of plan `p` (controller `c`): the command, the path,
+/// then random cycles. Panics with `text` when the interpreter disagrees.
+fn replay_hang(
+    ir: &Ir,
+    cid: CtrlId,
+    a: &PlanAnalysis,
+    hang: &rcs_dsl::analysis::command::Hang,
+    rng: &mut TestRng,
+    text: &str,
+) {
+    let c = ir.controller(cid);
+    let p = &c.plans[0];
+    let pinned: Vec<(Leaf, Value)> = hang
+        .command
+        .iter()
+        .map(|(l, v)| (a.terms().leaves[*l].0.clone(), v.clone()))
+        .collect();
+    let args = arguments(ir, c, p.verb.index(), &pinned);
+    let mut d = interp::Driven::new(ir, cid);
+    let mut reads: Vec<Value> = c
+        .reads
+        .iter()
+        .map(|b| interp::zero(ir, &Type::Buffer(ir.buffers[b.index()].ty)))
+        .collect();
+    d.command(&c.commands[p.verb.index()].name, &args).unwrap();
+    for step in &hang.path {
+        match step {
+            Step::Fire { row, witness } => {
+                apply_witness(ir, c, &mut d, &mut reads, witness);
+                let rec = d.cycle();
+                assert_eq!(
+                    rec.fired,
+                    Some(*row as u16),
+                    "path to {:?} with {args:?}: {} in\n{text}",
+                    hang.state,
+                    witness.text()
+                );
+            }
+            Step::Idle => {
+                let rec = d.cycle();
+                assert_eq!(rec.fired, None, "idle first cycle with {args:?} in\n{text}");
+            }
+        }
+    }
+    for cycle in 0..30 {
+        random_inputs(ir, c, &mut d, rng);
+        let rec = d.cycle();
+        assert_eq!(
+            rec.fired, None,
+            "hang in {:?} with {args:?}: a row fired after {cycle} cycles in\n{text}",
+            hang.state
+        );
+        assert_eq!(rec.state, hang.state.0 as u16, "left the hang in\n{text}");
+    }
+}
+
+/// Random runs of plan `p`: row `row` never fires.
+fn never_fires(ir: &Ir, cid: CtrlId, row: usize, rng: &mut TestRng, text: &str) {
+    let c = ir.controller(cid);
+    let verb = &c.commands[c.plans[0].verb.index()];
+    for _ in 0..60 {
+        let args: Vec<Value> = verb
+            .params
+            .iter()
+            .map(|q| random_value(ir, &q.ty, rng))
+            .collect();
+        let mut d = interp::Driven::new(ir, cid);
+        d.command(&verb.name, &args).unwrap();
+        for _ in 0..10 {
+            random_inputs(ir, c, &mut d, rng);
+            let rec = d.cycle();
+            assert_ne!(
+                rec.fired,
+                Some(row as u16),
+                "row {row} fired with {args:?} in\n{text}"
+            );
+        }
+    }
+}
+
+#[test]
+fn random_plans_hangs_replay_and_bound_rows_never_fire() {
+    use proptest::test_runner::{Config, TestRunner};
+    let cases: u32 = std::env::var("RCS_HANG_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(300);
+    let config = Config {
+        cases,
+        failure_persistence: None,
+        rng_algorithm: RngAlgorithm::ChaCha,
+        ..Config::default()
+    };
+    let mut runner =
+        TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
+    let rng = std::sync::Mutex::new(TestRng::deterministic_rng(RngAlgorithm::ChaCha));
+    let counts = std::sync::Mutex::new((0usize, 0usize));
+    runner
+        .run(&random_plans::plan(), |text| {
+            let sets = rcs_dsl::PlanSet::from_texts("p", [("p.rcs", text.as_str())], None);
+            let ir = rcs_dsl::lower_unchecked(&sets).expect("lowers");
+            let cid = CtrlId(1);
+            let c = ir.controller(cid);
+            let a = PlanAnalysis::new(&ir, c, &c.plans[0]);
+            let mut rng = rng.lock().unwrap();
+            let mut counts = counts.lock().unwrap();
+            for hang in a.hangs() {
+                replay_hang(&ir, cid, &a, &hang, &mut rng, &text);
+                counts.0 += 1;
+            }
+            for bound in a.entry_bound_rows() {
+                never_fires(&ir, cid, bound.row, &mut rng, &text);
+                counts.1 += 1;
+            }
+            Ok(())
+        })
+        .unwrap();
+    let (hangs, bound) = *counts.lock().unwrap();
+    eprintln!("hang: {cases} random plans; {hangs} hangs replayed, {bound} bound rows run");
+    assert!(hangs >= cases as usize / 10, "only {hangs} hangs");
+}

@@ -85,8 +85,8 @@ pub(crate) fn check_incomplete_states(
                 d = d.with_secondary(p.rows[*row].span, format!("enters `{name}`"));
             }
             Some(Step::Idle) => {
-                if let Some(entry) = p.rows.iter().find(|r| r.is_entry) {
-                    d = d.with_secondary(entry.span, "no row matches on the command's first cycle");
+                for entry in p.rows.iter().filter(|r| r.is_entry) {
+                    d = d.with_secondary(entry.span, "does not match with these values");
                 }
             }
             None => {}
@@ -123,17 +123,32 @@ pub(crate) fn check_incomplete_states(
                 ));
             }
         }
+        // `new_command = false` alone: no fixed value is involved.
+        let fixed = if shown.len() > 1 {
+            "these values stay fixed until the next command; whatever the other inputs do"
+        } else {
+            "whatever the inputs do"
+        };
         let d = d
             .with_note(format!(
-                "these values stay fixed until the next command; whatever the other inputs do \
-                 (buffers, hooks, subordinates, counters, vars that jobs change), `{}` stays in \
-                 `{name}` until a new command",
+                "{fixed} (buffers, hooks, subordinates, counters, vars that jobs change), `{}` \
+                 stays in `{name}` until a new command",
                 c.name
             ))
-            .with_help(format!(
-                "add a row for these values, an `otherwise` row, or a timeout \
-                 (`{name} when state_cycles > N -> Error(…)`)"
-            ));
+            .with_help(match hang.path.last() {
+                Some(Step::Idle) => "handle these values on the command's first cycle: an entry \
+                     row for them, or a last entry row `*N when new_command -> Error(…)` that \
+                     refuses them"
+                    .to_string(),
+                _ if hang.state == StateId::S0 => "entry rows fire only on a command's first \
+                     cycle: lead the row into another state, or add a row from `S0` for the \
+                     cycles after it"
+                    .to_string(),
+                _ => format!(
+                    "add a row for these values, an `otherwise` row, or a timeout \
+                     (`{name} when state_cycles > N -> Error(…)`)"
+                ),
+            });
         sink.lint(Some(c), Some(p), d);
     }
 }

@@ -39,6 +39,7 @@
 //! users to install. A node budget ([`search::BUDGET`]) bounds the worst
 //! case: past it, the answer is "unknown".
 
+mod case_text;
 pub mod command;
 pub mod domain;
 pub mod eval;

@@ -27,6 +27,7 @@ const HANG_CASES: &[&str] = &[
     "../tests/data/err/3204_incomplete_state_several_states.rcs",
     "../tests/data/err/3205_incomplete_state_back_to_s0.rcs",
     "../tests/data/err/3206_incomplete_state_timeout_for_some_values.rcs",
+    "../tests/data/err/3207_incomplete_state_after_a_subordinate.rcs",
     "../tests/data/err/1309_unreachable_row_enum_contradiction.rcs",
     "../tests/data/err/1310_unreachable_row_float_contradiction.rcs",
     "../tests/data/err/2105_shadowed_row_by_implication.rcs",

@@ -73,9 +73,9 @@ pub struct Hang {
     /// Every case with which the plan surely reaches `state` and hangs
     /// there, `command` first.
     pub cases: Vec<Case>,
-    /// No row on the path reads a parameter through an opaque atom, so
-    /// each case's path holds for every value of its cells (else only for
-    /// the representative values themselves).
+    /// No row on any case's path reads a parameter through an opaque
+    /// atom, so each case's path holds for every value of its cells (else
+    /// only for the representative values themselves).
     pub path_by_cells: bool,
 }
 
@@ -101,7 +101,8 @@ struct Walk {
     paths: Vec<Option<Vec<Step>>>,
 }
 
-/// A proved "no" or a possible edge, as the may walk found it.
+/// A row that may fire from one node into another, as the may walk found
+/// it.
 struct Edge {
     from: usize,
     row: usize,
@@ -194,9 +195,10 @@ impl PlanAnalysis<'_> {
                     given: given.clone(),
                     path: path.clone(),
                     cases: Vec::new(),
-                    path_by_cells: self.path_by_cells(path, n),
+                    path_by_cells: true,
                 });
                 hang.cases.push(case.clone());
+                hang.path_by_cells &= self.path_by_cells(path, n);
             }
         }
         // S0 on a later cycle is reported as S0 (first, as states are).

@@ -143,6 +143,9 @@ impl Code {
             Code::Lint(Lint::UnhandledError) => {
                 "a state waits for a subordinate that can fail, and nothing handles the failure"
             }
+            Code::Lint(Lint::IncompleteState) => {
+                "with some command values no row of a reachable state can ever fire: the plan hangs"
+            }
         }
     }
 

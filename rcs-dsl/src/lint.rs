@@ -19,10 +19,11 @@ pub enum Lint {
     FloatEquality,
     Unused,
     UnhandledError,
+    IncompleteState,
 }
 
 impl Lint {
-    pub const ALL: [Lint; 10] = [
+    pub const ALL: [Lint; 11] = [
         Lint::RuleOfTen,
         Lint::ShadowedRow,
         Lint::UnreachableState,
@@ -33,6 +34,7 @@ impl Lint {
         Lint::FloatEquality,
         Lint::Unused,
         Lint::UnhandledError,
+        Lint::IncompleteState,
     ];
 
     pub fn name(self) -> &'static str {
@@ -47,6 +49,7 @@ impl Lint {
             Lint::FloatEquality => "float_equality",
             Lint::Unused => "unused",
             Lint::UnhandledError => "unhandled_error",
+            Lint::IncompleteState => "incomplete_state",
         }
     }
 

@@ -23,13 +23,16 @@ pub fn cells(ir: &Ir, terms: &Terms) -> Vec<Vec<Value>> {
         .leaves
         .iter()
         .enumerate()
-        .map(|(i, (_, ty))| {
-            let constants: Vec<Value> = terms.splits[i]
-                .iter()
-                .filter_map(|c| eval(c, &|_| None))
-                .collect();
-            cells_of(ir, ty, &constants)
-        })
+        .map(|(i, (_, ty))| cells_of(ir, ty, &split_constants(terms, i)))
+        .collect()
+}
+
+/// The constants the exact atoms of leaf `leaf` compare it with: where
+/// its cells are cut.
+pub fn split_constants(terms: &Terms, leaf: usize) -> Vec<Value> {
+    terms.splits[leaf]
+        .iter()
+        .filter_map(|c| eval(c, &|_| None))
         .collect()
 }
 
@@ -141,6 +144,14 @@ fn cells_of(ir: &Ir, ty: &Type, constants: &[Value]) -> Vec<Value> {
 /// `x OP c` is constant on each piece. One value per piece, the one
 /// nearest 0.
 fn int_cells(t: IntTy, constants: &[Value]) -> Vec<Value> {
+    int_cell_bounds(t, constants)
+        .into_iter()
+        .map(|(a, b)| Value::Int(0.clamp(a, b)))
+        .collect()
+}
+
+/// The pieces of [`int_cells`], as inclusive bounds, in order.
+pub fn int_cell_bounds(t: IntTy, constants: &[Value]) -> Vec<(i128, i128)> {
     let (lo, hi) = t.range();
     let mut starts = vec![lo];
     for c in constants {
@@ -157,7 +168,7 @@ fn int_cells(t: IntTy, constants: &[Value]) -> Vec<Value> {
     let mut out = Vec::with_capacity(starts.len());
     for (i, &a) in starts.iter().enumerate() {
         let b = starts.get(i + 1).map_or(hi, |n| n - 1);
-        out.push(Value::Int(0.clamp(a, b)));
+        out.push((a, b));
     }
     out
 }

@@ -39,6 +39,8 @@
 //! users to install. A node budget ([`search::BUDGET`]) bounds the worst
 //! case: past it, the answer is "unknown".
 
+mod case_text;
+pub mod command;
 pub mod domain;
 pub mod eval;
 pub mod path;
@@ -192,9 +194,7 @@ impl<'ir> PlanAnalysis<'ir> {
             return None;
         }
         let none = Formula::Not(Box::new(some_row));
-        let candidates = self
-            .candidates
-            .get_or_init(|| domain::candidates(self.ir, &self.terms, &self.cells));
+        let candidates = self.candidates();
         match Search::new(&self.terms, Mode::Witness, candidates, &[], &fixed).run(&none) {
             Outcome::Found(values) => Some(self.witness(&none, state, values)),
             Outcome::None | Outcome::Unknown => None,
@@ -389,6 +389,12 @@ impl<'ir> PlanAnalysis<'ir> {
         }
     }
 
+    /// The values a witness search tries, made on first use.
+    fn candidates(&self) -> &[Vec<Value>] {
+        self.candidates
+            .get_or_init(|| domain::candidates(self.ir, &self.terms, &self.cells))
+    }
+
     fn prove(&self, f: &Formula, fixed: &[(LeafId, Value)]) -> Outcome {
         Search::new(&self.terms, Mode::Prove, &self.cells, &self.tables, fixed).run(f)
     }
@@ -399,9 +405,7 @@ impl<'ir> PlanAnalysis<'ir> {
             Outcome::Unknown => return Answer::Unknown,
             Outcome::Found(_) => {}
         }
-        let candidates = self
-            .candidates
-            .get_or_init(|| domain::candidates(self.ir, &self.terms, &self.cells));
+        let candidates = self.candidates();
         let search = Search::new(&self.terms, Mode::Witness, candidates, &[], fixed);
         match search.run(f) {
             Outcome::Found(values) => Answer::Can(self.witness(f, state, values)),

@@ -136,11 +136,19 @@ pub(crate) fn check_unreachable_states(c: &Controller, p: &Plan, a: &Analysis, s
     }
 }
 
+impl Analysis {
+    /// Whether `dead_end_state` reports state `i`: reached, and only a new
+    /// command leaves it (`S0` of a plan without entry rows is
+    /// `entry_missing`'s).
+    pub fn is_dead_end(&self, p: &Plan, i: usize) -> bool {
+        let dead = !self.leaves[i] || (i == 0 && self.s0_dead_on_return);
+        dead && self.reachable[i] && (i != 0 || p.rows.iter().any(|r| r.is_entry))
+    }
+}
+
 pub(crate) fn check_dead_ends(c: &Controller, p: &Plan, a: &Analysis, sink: &mut Sink) {
-    let has_entry = p.rows.iter().any(|r| r.is_entry);
     for (i, s) in p.states.iter().enumerate() {
-        let dead = !a.leaves[i] || (i == 0 && a.s0_dead_on_return);
-        if !dead || !a.reachable[i] || (i == 0 && !has_entry) {
+        if !a.is_dead_end(p, i) {
             continue;
         }
         let span = s.span.unwrap_or(p.header);

@@ -5,6 +5,7 @@
 
 mod graph;
 mod handshake;
+mod hang;
 mod hierarchy;
 mod plan;
 mod usage;
@@ -99,10 +100,14 @@ pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagno
             plan::check_double_commands(ir, p, &mut sink);
             plan::check_rule_of_ten(ir, c, p, &mut sink);
             plan::check_unreachable_rows(p, analysis, &mut sink);
-            plan::check_shadowed_rows(c, p, analysis, conditions, &mut sink);
+            let bound = hang::entry_bound_rows(p, analysis, conditions);
+            hang::check_entry_bound_rows(p, &bound, conditions, &mut sink);
+            let bound: Vec<usize> = bound.iter().map(|b| b.row).collect();
+            plan::check_shadowed_rows(c, p, analysis, conditions, &bound, &mut sink);
             graph::check_unreachable_states(c, p, analysis, &mut sink);
             graph::check_dead_ends(c, p, analysis, &mut sink);
             graph::check_no_done(ir, c, p, analysis, &mut sink);
+            hang::check_incomplete_states(c, p, conditions, analysis, &mut sink);
         }
     }
     let plans = handshake::Plans { conditions, graphs };

@@ -227,16 +227,18 @@ pub(crate) fn check_unreachable_rows(p: &Plan, a: &Analysis, sink: &mut Sink) {
 /// matches whenever this one does. Decided by the analysis of conditions,
 /// so implication, several rows together, enum and status exhaustion and
 /// integer ranges all count; the earlier rows that can match together with
-/// this one are named.
+/// this one are named. Rows in `entry_bound` are `unreachable_row`'s.
 pub(crate) fn check_shadowed_rows(
     c: &Controller,
     p: &Plan,
     a: &Analysis,
     conditions: &PlanAnalysis,
+    entry_bound: &[usize],
     sink: &mut Sink,
 ) {
     for (j, later) in p.rows.iter().enumerate() {
-        if later.is_otherwise() || a.never_matches[j] {
+        // A row reported as `unreachable_row` is not also shadowed.
+        if later.is_otherwise() || a.never_matches[j] || entry_bound.contains(&j) {
             continue;
         }
         let states: Vec<StateId> = (0..p.states.len())

@@ -143,6 +143,15 @@ impl Code {
             Code::Lint(Lint::UnhandledError) => {
                 "a state waits for a subordinate that can fail, and nothing handles the failure"
             }
+            Code::Lint(Lint::Livelock) => {
+                "rows move between states every cycle, so no other row can ever fire"
+            }
+            Code::Lint(Lint::CommandEveryCycle) => {
+                "a command is sent again every cycle while the subordinate executes it"
+            }
+            Code::Lint(Lint::StatusNeverReported) => {
+                "a supervisor waits for a status the subordinate never reports"
+            }
         }
     }
 

@@ -19,10 +19,13 @@ pub enum Lint {
     FloatEquality,
     Unused,
     UnhandledError,
+    Livelock,
+    CommandEveryCycle,
+    StatusNeverReported,
 }
 
 impl Lint {
-    pub const ALL: [Lint; 10] = [
+    pub const ALL: [Lint; 13] = [
         Lint::RuleOfTen,
         Lint::ShadowedRow,
         Lint::UnreachableState,
@@ -33,6 +36,9 @@ impl Lint {
         Lint::FloatEquality,
         Lint::Unused,
         Lint::UnhandledError,
+        Lint::Livelock,
+        Lint::CommandEveryCycle,
+        Lint::StatusNeverReported,
     ];
 
     pub fn name(self) -> &'static str {
@@ -47,6 +53,9 @@ impl Lint {
             Lint::FloatEquality => "float_equality",
             Lint::Unused => "unused",
             Lint::UnhandledError => "unhandled_error",
+            Lint::Livelock => "livelock",
+            Lint::CommandEveryCycle => "command_every_cycle",
+            Lint::StatusNeverReported => "status_never_reported",
         }
     }
 

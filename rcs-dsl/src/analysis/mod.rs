@@ -39,6 +39,7 @@
 //! users to install. A node budget ([`search::BUDGET`]) bounds the worst
 //! case: past it, the answer is "unknown".
 
+pub mod cycles;
 pub mod domain;
 pub mod eval;
 pub mod search;
@@ -287,6 +288,26 @@ impl<'ir> PlanAnalysis<'ir> {
         let (f, mut fixed, state) = self.question(Question::FiresIn(row, state));
         fixed.extend(given.iter().cloned());
         self.decide(&f, &fixed, state)
+    }
+
+    /// Whether several rows can each fire in their state under one
+    /// assignment of the leaves, with the `given` ones pinned (the caller
+    /// pins the counters and `new_command`, which the firings share): the
+    /// question of rows that fire in turn while the inputs stay the same.
+    pub fn can_fire_all_given(
+        &self,
+        firings: &[(usize, StateId)],
+        given: &[(LeafId, Value)],
+    ) -> Answer {
+        let mut parts = Vec::new();
+        for &(row, state) in firings {
+            match self.fires(row, state) {
+                Some(f) => parts.push(f),
+                None => return Answer::Never,
+            }
+        }
+        let state = firings.first().map_or(StateId::S0, |f| f.1);
+        self.decide(&Formula::And(parts), given, state)
     }
 
     /// Whether no row covering `state` can match, whatever the leaves not

@@ -44,6 +44,7 @@ pub mod domain;
 pub mod eval;
 pub mod search;
 pub mod terms;
+mod walk;
 
 use crate::ir::{Condition, Controller, CtrlId, From, Ir, Plan, StateId, StatusId, Type};
 use rcs_runtime::driver::Value;

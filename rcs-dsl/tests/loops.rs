@@ -4,7 +4,8 @@
 //! entry is replayed cycle by cycle (each step's inputs, then the row it
 //! says fires); then:
 //!
-//! - a livelock's inputs are held for 30 cycles: the states go round the
+//! - a livelock's inputs are held for 1500 cycles (past the `plan_cycles`
+//!   constants of the cases): the states go round the
 //!   cycle exactly as claimed, one of its rows per cycle, so no other row
 //!   (the timeout the finding names included) ever fires;
 //! - a command storm's inputs are given with the subordinate showing
@@ -189,7 +190,8 @@ fn livelocks_go_round_on_the_interpreter() {
             rig.walk(&lock.path, case);
             rig.give(&lock.held);
             let n = lock.cycle.len();
-            for k in 0..30 {
+            // Past 30 cycles, and past the plan-cycle constants of the cases.
+            for k in 0..1500 {
                 let (row, state) = lock.cycle[k % n];
                 let (_, next) = lock.cycle[(k + 1) % n];
                 let rec = rig.cycle();

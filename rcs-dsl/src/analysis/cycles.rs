@@ -9,7 +9,9 @@
 //! interpreter — one computation for both.
 
 use super::terms::Leaf;
-use super::walk::{can, is_counter, not_ready, sends, target_state, value_of, Held, Place, Walker};
+use super::walk::{
+    can, fires_on, is_counter, not_ready, sends, target_state, value_of, Held, Place, Walker,
+};
 pub use super::walk::{Inputs, Step};
 use super::{covers, LeafId, PlanAnalysis};
 use crate::ir::{Controller, CtrlId, Plan, StateId, StatusId, Target};
@@ -103,16 +105,29 @@ pub fn livelocks(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<Livel
         let Some(w) = can(an.can_fire_all_given(&cycle, &pins)) else {
             continue;
         };
+        let mut held = Held::of(an, &w);
+        // A leaf the first witness left open may matter at a later value
+        // of `plan_cycles`: hold the value the rows need there too (the
+        // rows fired before whatever its value, so they still do).
+        for pc in &plan_cycle_values {
+            for &(r, s) in &cycle {
+                let mut pins = walker.counter_pins(1, *pc);
+                pins.extend(held.pins.iter().cloned());
+                if let Some(w) = can(an.can_fire_in_given(r, s, &pins)) {
+                    held.extend(an, &w);
+                }
+            }
+        }
         let Held {
             inputs: held,
             pins: held_pins,
             shown,
-        } = Held::of(an, &w);
+        } = held;
         let holds_for = |pc: u32| {
             cycle.iter().all(|&(r, s)| {
                 let mut pins = walker.counter_pins(1, pc);
                 pins.extend(held_pins.iter().cloned());
-                can(an.can_fire_in_given(r, s, &pins)).is_some()
+                fires_on(an, r, s, &pins)
             })
         };
         if !plan_cycle_values.iter().all(|pc| holds_for(*pc)) {
@@ -224,14 +239,32 @@ fn storm_after(walker: &Walker, at: &Place, row: usize, x: CtrlId) -> Option<Com
         // which the walk from there covers.
         return None;
     }
+    // The same inputs on the next cycle, with the counters one on; a leaf
+    // the first witness left open is held at what the second one needs.
+    let mut held = Held::of(an, &w);
+    let counters = [
+        (at.state_cycles, at.plan_cycles),
+        (at.state_cycles.saturating_add(1), at.plan_cycles + 1),
+    ];
+    let mut again = walker.counter_pins(counters[1].0, counters[1].1);
+    again.extend(held.pins.iter().cloned());
+    held.extend(an, &can(an.can_fire_in_given(row, state, &again))?);
+    let answered = walker.statuses.iter().all(|(y, leaf)| {
+        !at.sent.contains(y) || value_of(an, &held.inputs, *leaf) != Some(&not_ready())
+    });
+    let repeats = counters.iter().all(|&(sc, pc)| {
+        let mut pins = walker.counter_pins(sc, pc);
+        pins.extend(held.pins.iter().cloned());
+        fires_on(an, row, state, &pins)
+    });
+    if !answered || !repeats {
+        return None;
+    }
     let Held {
         inputs: repeat,
-        pins,
         mut shown,
-    } = Held::of(an, &w);
-    let mut again = walker.counter_pins(at.state_cycles.saturating_add(1), at.plan_cycles + 1);
-    again.extend(pins);
-    can(an.can_fire_in_given(row, state, &again))?;
+        ..
+    } = held;
     let x_name = an.leaf_name(&Leaf::SubStatus(x));
     if !shown.iter().any(|(n, _)| *n == x_name) {
         shown.push((x_name, "EXECUTING".into()));

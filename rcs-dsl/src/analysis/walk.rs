@@ -61,6 +61,25 @@ impl Held {
             shown,
         }
     }
+
+    /// Add the inputs of `w` that are not held yet.
+    pub(super) fn extend(&mut self, an: &PlanAnalysis, w: &Witness) {
+        let more = Held::of(an, w);
+        for (leaf, v) in more.inputs {
+            let Some(id) = an.terms().find(&leaf) else {
+                continue;
+            };
+            if !self.pins.iter().any(|(p, _)| *p == id) {
+                self.pins.push((id, v.clone()));
+                self.inputs.push((leaf, v));
+            }
+        }
+        for (name, v) in more.shown {
+            if !self.shown.iter().any(|(n, _)| *n == name) {
+                self.shown.push((name, v));
+            }
+        }
+    }
 }
 
 /// One cycle of a walk: the row that fires, the state it fires in, and the
@@ -318,4 +337,24 @@ pub(super) fn value_of<'v>(
         .iter()
         .find(|(l, _)| an.terms().find(l) == Some(id))
         .map(|(_, v)| v)
+}
+
+/// Whether `row` fires in `state` on the `pins` alone: a witness that
+/// needs no other input. A held set of inputs that leaves some leaf open
+/// must not lean on a value the search would pick for it.
+pub(super) fn fires_on(
+    an: &PlanAnalysis,
+    row: usize,
+    state: StateId,
+    pins: &[(LeafId, Value)],
+) -> bool {
+    can(an.can_fire_in_given(row, state, pins)).is_some_and(|w| {
+        w.inputs.iter().all(|(l, _)| {
+            is_counter(l)
+                || an
+                    .terms()
+                    .find(l)
+                    .is_some_and(|id| pins.iter().any(|(p, _)| *p == id))
+        })
+    })
 }

@@ -15,6 +15,8 @@
 //! The check and this test share one computation,
 //! `rcs_dsl::analysis::cycles`.
 
+use proptest::prelude::*;
+use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use rcs_dsl::analysis::cycles::{command_storms, livelocks, Inputs, Step};
 use rcs_dsl::analysis::terms::{Leaf, Step as PathStep};
 use rcs_dsl::analysis::PlanAnalysis;
@@ -181,60 +183,175 @@ fn replay_cases(
     found
 }
 
+/// Replay every livelock of one plan; how many.
+fn replay_livelocks(case: &str, ir: &Ir, c: CtrlId, p: &Plan, a: &PlanAnalysis) -> usize {
+    let locks = livelocks(ir.controller(c), p, a);
+    for lock in &locks {
+        let mut rig = Rig::new(ir, c, p, &lock.params);
+        rig.walk(&lock.path, case);
+        rig.give(&lock.held);
+        let n = lock.cycle.len();
+        // Past 30 cycles, and past the plan-cycle constants of the cases.
+        for k in 0..1500 {
+            let (row, state) = lock.cycle[k % n];
+            let (_, next) = lock.cycle[(k + 1) % n];
+            let rec = rig.cycle();
+            assert_eq!(
+                (rec.fired, rec.state),
+                (Some(row as u16), next.0 as u16),
+                "{case}: cycle {k} of the loop, in state {state:?}"
+            );
+            assert_ne!(rec.fired, Some(lock.defeated.0 as u16));
+        }
+    }
+    locks.len()
+}
+
+/// Replay every command storm of one plan; how many.
+fn replay_storms(case: &str, ir: &Ir, c: CtrlId, p: &Plan, a: &PlanAnalysis) -> usize {
+    let ctrl = ir.controller(c);
+    let storms = command_storms(ctrl, p, a);
+    for storm in &storms {
+        let mut rig = Rig::new(ir, c, p, &storm.params);
+        rig.walk(&storm.path, case);
+        let x = ctrl.subordinate_index(storm.sub).unwrap();
+        let first = rig.d.last_sent(&ir.controller(storm.sub).name).unwrap();
+        assert_ne!(first, 0, "{case}: the walk ends with a send");
+        rig.give(&storm.repeat);
+        rig.statuses[x] = Some(StatusId::EXECUTING.0 as u16);
+        let mut serial = first;
+        for k in 0..2 {
+            let rec = rig.cycle();
+            assert_eq!(rec.fired, Some(storm.row as u16), "{case}: repeat {k}");
+            assert_eq!(rec.state, storm.state.0 as u16);
+            let sent: Vec<_> = rec.sent.iter().filter(|s| s.sub as usize == x).collect();
+            assert_eq!(sent.len(), 1, "{case}: repeat {k} sends");
+            assert_ne!(sent[0].serial, serial, "{case}: a new command each time");
+            serial = sent[0].serial;
+        }
+    }
+    storms.len()
+}
+
 #[test]
 fn livelocks_go_round_on_the_interpreter() {
-    let found = replay_cases("33", |case, ir, c, p, a| {
-        let locks = livelocks(ir.controller(c), p, a);
-        for lock in &locks {
-            let mut rig = Rig::new(ir, c, p, &lock.params);
-            rig.walk(&lock.path, case);
-            rig.give(&lock.held);
-            let n = lock.cycle.len();
-            // Past 30 cycles, and past the plan-cycle constants of the cases.
-            for k in 0..1500 {
-                let (row, state) = lock.cycle[k % n];
-                let (_, next) = lock.cycle[(k + 1) % n];
-                let rec = rig.cycle();
-                assert_eq!(
-                    (rec.fired, rec.state),
-                    (Some(row as u16), next.0 as u16),
-                    "{case}: cycle {k} of the loop, in state {state:?}"
-                );
-                assert_ne!(rec.fired, Some(lock.defeated.0 as u16));
-            }
-        }
-        locks.len()
-    });
+    let found = replay_cases("33", replay_livelocks);
     assert!(found >= 3, "only {found} livelocks replayed");
 }
 
 #[test]
 fn command_storms_send_on_consecutive_cycles_on_the_interpreter() {
-    let found = replay_cases("34", |case, ir, c, p, a| {
-        let ctrl = ir.controller(c);
-        let storms = command_storms(ctrl, p, a);
-        for storm in &storms {
-            let mut rig = Rig::new(ir, c, p, &storm.params);
-            rig.walk(&storm.path, case);
-            let x = ctrl.subordinate_index(storm.sub).unwrap();
-            let first = rig.d.last_sent(&ir.controller(storm.sub).name).unwrap();
-            assert_ne!(first, 0, "{case}: the walk ends with a send");
-            rig.give(&storm.repeat);
-            rig.statuses[x] = Some(StatusId::EXECUTING.0 as u16);
-            let mut serial = first;
-            for k in 0..2 {
-                let rec = rig.cycle();
-                assert_eq!(rec.fired, Some(storm.row as u16), "{case}: repeat {k}");
-                assert_eq!(rec.state, storm.state.0 as u16);
-                let sent: Vec<_> = rec.sent.iter().filter(|s| s.sub as usize == x).collect();
-                assert_eq!(sent.len(), 1, "{case}: repeat {k} sends");
-                assert_ne!(sent[0].serial, serial, "{case}: a new command each time");
-                serial = sent[0].serial;
-            }
-        }
-        storms.len()
-    });
+    let found = replay_cases("34", replay_storms);
     assert!(found >= 3, "only {found} command storms replayed");
+}
+
+/// A random row: from a state or `*`, a condition over the inputs, the
+/// counters, the parameter and the subordinate, a target, maybe a send.
+fn row() -> impl Strategy<Value = String> {
+    let atom = prop::sample::select(vec![
+        "s.a",
+        "!s.a",
+        "s.b",
+        "!s.b",
+        "s.n < 3",
+        "s.n >= 3",
+        "state_cycles > 1",
+        "state_cycles > 4",
+        "state_cycles == 1",
+        "plan_cycles > 5",
+        "plan_cycles > 1000",
+        "cmd.k == 0",
+        "cmd.k > 0",
+        "X.done",
+        "X.executing",
+        "!X.executing",
+        "X.status == NOT_READY",
+        "X.error",
+    ]);
+    let from = prop::sample::select(vec!["S1", "S2", "S3", "*"]);
+    // Mostly to states, for rings to form.
+    let to = prop::sample::select(vec!["S1", "S2", "S3", "S1", "S2", "S3", "same", "Done"]);
+    (
+        from,
+        prop::collection::vec(atom, 1..=2),
+        to,
+        prop::bool::weighted(0.3),
+    )
+        .prop_map(|(from, atoms, to, send)| {
+            let send = if send { " { X <- RUN }" } else { "" };
+            format!("        {from} when {} -> {to}{send}\n", atoms.join(" && "))
+        })
+}
+
+fn random_plan() -> impl Strategy<Value = String> {
+    (
+        prop::bool::ANY,
+        prop::bool::ANY,
+        prop::collection::vec(row(), 2..=7),
+    )
+        .prop_map(|(send, timeout, rows)| {
+            let send = if send { " { X <- RUN }" } else { "" };
+            // A timeout over every state, first, for rings to defeat.
+            let timeout = if timeout {
+                "        * when state_cycles > 4 -> Error\n"
+            } else {
+                ""
+            };
+            format!(
+                "buffer In {{ a: bool, b: bool, n: u8 }}
+controller P {{
+    subordinates X
+    reads s: In
+    command GO(k: u8)
+    plan GO {{
+        * when new_command -> S1{send}
+{timeout}{}    }}
+}}
+controller X {{
+    command RUN
+    plan RUN {{ * when new_command -> Done }}
+}}
+",
+                rows.concat()
+            )
+        })
+}
+
+/// On random plans, every livelock and command storm found replays as
+/// claimed: no false alarm. Not vacuous: both are found in some.
+#[test]
+fn random_plans_replay_every_finding() {
+    let config = Config {
+        cases: 800,
+        failure_persistence: None,
+        rng_algorithm: RngAlgorithm::ChaCha,
+        ..Config::default()
+    };
+    let mut runner =
+        TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
+    let found = std::cell::Cell::new((0, 0));
+    runner
+        .run(&random_plan(), |text| {
+            let set = rcs_dsl::PlanSet::from_texts("p", [("p.rcs", text.as_str())], None);
+            let Some(ir) = rcs_dsl::lower_unchecked(&set) else {
+                return Ok(());
+            };
+            let (c, p) = (CtrlId(0), &ir.controllers[0].plans[0]);
+            let a = PlanAnalysis::new(&ir, &ir.controllers[0], p);
+            let (l, s) = found.get();
+            found.set((
+                l + replay_livelocks(&text, &ir, c, p, &a),
+                s + replay_storms(&text, &ir, c, p, &a),
+            ));
+            Ok(())
+        })
+        .unwrap();
+    let (locks, storms) = found.get();
+    eprintln!("loops: 800 random plans; {locks} livelocks, {storms} command storms replayed");
+    assert!(
+        locks >= 5 && storms >= 5,
+        "{locks} livelocks, {storms} storms"
+    );
 }
 
 /// The clean cases give no finding at all.

@@ -265,6 +265,17 @@ fn storm_after(walker: &Walker, at: &Place, row: usize, x: CtrlId) -> Option<Com
         mut shown,
         ..
     } = held;
+    // Parameters the walk left open and the repeats read: the command
+    // carries them from the start (the walk did not depend on them).
+    let mut params = walker.params(&at.pinned);
+    for (leaf, v) in &repeat {
+        let is_new = !params
+            .iter()
+            .any(|(p, _)| an.terms().find(p) == an.terms().find(leaf));
+        if matches!(leaf, Leaf::Param(..)) && is_new {
+            params.push((leaf.clone(), v.clone()));
+        }
+    }
     let x_name = an.leaf_name(&Leaf::SubStatus(x));
     if !shown.iter().any(|(n, _)| *n == x_name) {
         shown.push((x_name, "EXECUTING".into()));
@@ -276,11 +287,11 @@ fn storm_after(walker: &Walker, at: &Place, row: usize, x: CtrlId) -> Option<Com
         state,
         repeat,
         shown,
-        params: walker.params(&at.pinned),
+        params,
     })
 }
 
-/// The first row, in a state of `cycle`, other than the cycle's row there,
+/// The first row, in a state of `cycle`, other than the cycle's rows,
 /// that can fire in that state with `held` pinned and the counters free,
 /// with the inputs of such a cycle.
 fn defeated_row(
@@ -290,9 +301,10 @@ fn defeated_row(
     held: &[(LeafId, Value)],
 ) -> Option<((usize, StateId), Inputs)> {
     let new_command = an.terms().find(&Leaf::NewCommand);
-    for &(looping, state) in cycle {
+    for &(_, state) in cycle {
         for (i, row) in plan.rows.iter().enumerate() {
-            if i == looping || !covers(&row.from, state) {
+            // A row of the ring fires in its own state: not a row kept out.
+            if cycle.iter().any(|(r, _)| *r == i) || !covers(&row.from, state) {
                 continue;
             }
             let mut pins = held.to_vec();

@@ -277,21 +277,30 @@ fn statuses_reported(
     Some(reported)
 }
 
-/// The statuses of `x` a row's condition tests for, with the test's span:
-/// `x.done`, `x.error`, `x.status == S` (either way round).
+/// The statuses of `x` a row's condition waits for, with the test's span:
+/// `x.done`, `x.error`, `x.status == S` (either way round), where the
+/// condition holds only if the test does (not under a `!`).
 fn status_tests(r: &Row, x: CtrlId) -> Vec<(StatusId, crate::source::Span)> {
     let mut found = Vec::new();
-    let crate::ir::Condition::When(e) = &r.cond else {
-        return found;
-    };
+    if let crate::ir::Condition::When(e) = &r.cond {
+        waits_in(e, x, &mut found);
+    }
+    found
+}
+
+fn waits_in(e: &Expr, x: CtrlId, found: &mut Vec<(StatusId, crate::source::Span)>) {
     let status_of_x = |e: &Expr| matches!(e.kind, ExprKind::Sub(c, SubProp::Status) if c == x);
     let constant = |e: &Expr| match e.kind {
         ExprKind::Status(s) => Some(s),
         _ => None,
     };
-    e.visit(&mut |e| match &e.kind {
+    match &e.kind {
         ExprKind::Sub(c, SubProp::Done) if *c == x => found.push((StatusId::DONE, e.span)),
         ExprKind::Sub(c, SubProp::Error) if *c == x => found.push((StatusId::ERROR, e.span)),
+        ExprKind::Binary(BinOp::And | BinOp::Or, l, r) => {
+            waits_in(l, x, found);
+            waits_in(r, x, found);
+        }
         ExprKind::Binary(BinOp::Eq, l, r) => {
             let tested = if status_of_x(l) {
                 constant(r)
@@ -305,6 +314,5 @@ fn status_tests(r: &Row, x: CtrlId) -> Vec<(StatusId, crate::source::Span)> {
             }
         }
         _ => {}
-    });
-    found
+    }
 }

@@ -38,6 +38,11 @@
 //! the whole procedure is a few hundred lines with no native dependency for
 //! users to install. A node budget ([`search::BUDGET`]) bounds the worst
 //! case: past it, the answer is "unknown".
+//!
+//! Questions over several cycles (a ring of states the plan goes round, a
+//! command sent again on the next cycle) are answered from these one-cycle
+//! questions, along walks from the entry with the counters each walk
+//! implies: [`cycles`].
 
 pub mod cycles;
 pub mod domain;

@@ -1,5 +1,5 @@
 //! Stage 3a, over several cycles: what one plan does on consecutive
-//! cycles, on [`super::walk`]s from its entry. Two findings come out of
+//! cycles, on walks from its entry (`walk.rs`). Two findings come out of
 //! it, each with the way there from the entry and the inputs that make it
 //! happen: a **livelock** (rows that move between states on every cycle
 //! under inputs held constant) and a **command storm** (a row that sends

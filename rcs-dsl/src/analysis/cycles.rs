@@ -199,8 +199,10 @@ pub fn command_storms(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<
     };
     let mut found: Vec<CommandStorm> = Vec::new();
     for at in walker.walk(Vec::new()) {
-        let Some(last) = at.path.last() else { continue };
-        let (row, r) = (last.row, &plan.rows[last.row]);
+        let Some(row) = at.path.last().and_then(|s| s.row) else {
+            continue;
+        };
+        let r = &plan.rows[row];
         if !candidates.contains(&row) || !covers(&r.from, at.state) {
             continue;
         }
@@ -262,9 +264,17 @@ fn storm_after(walker: &Walker, at: &Place, row: usize, x: CtrlId) -> Option<Com
     }
     let Held {
         inputs: repeat,
-        mut shown,
+        shown: held_shown,
         ..
     } = held;
+    // The counters the row reads, as on the first repeat: they say when.
+    let mut shown: Vec<(String, String)> = w
+        .shown
+        .iter()
+        .filter(|(n, _)| matches!(n.as_str(), "state_cycles" | "plan_cycles"))
+        .cloned()
+        .collect();
+    shown.extend(held_shown);
     // Parameters the walk left open and the repeats read: the command
     // carries them from the start (the walk did not depend on them).
     let mut params = walker.params(&at.pinned);

@@ -316,23 +316,40 @@ impl<'ir> PlanAnalysis<'ir> {
         self.decide(&Formula::And(parts), given, state)
     }
 
+    /// Whether, in `state`, a cycle can go by with no row firing (the plan
+    /// waits), with the `given` leaves pinned: no row covering `state`
+    /// matches, and the plan has no `otherwise`.
+    pub fn can_idle_given(&self, state: StateId, given: &[(LeafId, Value)]) -> Answer {
+        let Some(any) = self.conditions_covering(state) else {
+            return Answer::Never;
+        };
+        let mut fixed = self.fixed(state);
+        fixed.extend(given.iter().cloned());
+        self.decide(&Formula::Not(Box::new(Formula::Or(any))), &fixed, state)
+    }
+
     /// Whether no row covering `state` can match, whatever the leaves not
     /// in `given` are: the plan cannot leave `state` (nor run any job
     /// there) while the `given` values hold. A proof: `false` when unknown.
     pub fn nothing_matches_given(&self, state: StateId, given: &[(LeafId, Value)]) -> bool {
-        let mut any = Vec::new();
-        for (i, row) in self.plan.rows.iter().enumerate() {
-            if covers(&row.from, state) {
-                match &self.conds[i] {
-                    Some(c) => any.push(Formula::Shared(c.clone())),
-                    // An `otherwise` row matches when nothing else does.
-                    None => return false,
-                }
-            }
-        }
+        let Some(any) = self.conditions_covering(state) else {
+            return false;
+        };
         let mut fixed = self.fixed(state);
         fixed.extend(given.iter().cloned());
         matches!(self.prove(&Formula::Or(any), &fixed), Outcome::None)
+    }
+
+    /// The conditions of the rows covering `state`; `None` when an
+    /// `otherwise` row covers it (it matches when nothing else does).
+    fn conditions_covering(&self, state: StateId) -> Option<Vec<Formula>> {
+        let mut any = Vec::new();
+        for (i, row) in self.plan.rows.iter().enumerate() {
+            if covers(&row.from, state) {
+                any.push(Formula::Shared(self.conds[i].clone()?));
+            }
+        }
+        Some(any)
     }
 
     fn proves_never(&self, q: Question) -> bool {

@@ -4,9 +4,10 @@
 //!
 //! A walk starts with the new command (`S0`, `new_command`, both counters
 //! 0) and takes, on each cycle, a row that the analysis shows can fire
-//! there (a concrete witness, never "unknown"), with the counters the walk
-//! implies: `plan_cycles` is the walk's length, `state_cycles` restarts at
-//! 1 on the first cycle in a new state and grows by one on a stay. The
+//! there, or a wait (a cycle on which no row matches) — each shown by a
+//! concrete witness, never "unknown" — with the counters the walk implies:
+//! `plan_cycles` is the walk's length, `state_cycles` restarts at 1 on the
+//! first cycle in a new state and grows by one on a stay. The
 //! command's parameters and the vars no job assigns keep one value along
 //! the walk; a subordinate the walk has not commanded yet shows
 //! `NOT_READY`, one it has commanded never does; each subordinate writes
@@ -21,7 +22,7 @@ use rcs_runtime::driver::Value;
 
 /// How many cycles a walk takes at most, and how many places it keeps per
 /// cycle: plans are small, and past these the answer is "nothing found".
-const MAX_DEPTH: usize = 16;
+const MAX_DEPTH: usize = 24;
 const MAX_WIDTH: usize = 64;
 
 /// Inputs of a cycle: leaves with their values.
@@ -82,11 +83,12 @@ impl Held {
     }
 }
 
-/// One cycle of a walk: the row that fires, the state it fires in, and the
-/// inputs of that cycle (the leaves the question read, with their values).
+/// One cycle of a walk: the row that fires (`None`: none does, the plan
+/// waits), the state it fires in, and the inputs of that cycle (the leaves
+/// the question read, with their values).
 #[derive(Clone, Debug)]
 pub struct Step {
-    pub row: usize,
+    pub row: Option<usize>,
     pub state: StateId,
     pub inputs: Vec<(Leaf, Value)>,
 }
@@ -191,8 +193,21 @@ impl<'a, 'ir> Walker<'a, 'ir> {
         pins: &[(LeafId, Value)],
         sent: &[CtrlId],
     ) -> Option<Witness> {
+        self.answered(pins, sent, |pins| {
+            self.an.can_fire_in_given(row, state, pins)
+        })
+    }
+
+    /// A witness of `ask` with `pins`, in which no subordinate in `sent`
+    /// shows `NOT_READY`: each one that does is tried at its other values.
+    fn answered(
+        &self,
+        pins: &[(LeafId, Value)],
+        sent: &[CtrlId],
+        ask: impl Fn(&[(LeafId, Value)]) -> Answer,
+    ) -> Option<Witness> {
         let mut pins = pins.to_vec();
-        let mut w = can(self.an.can_fire_in_given(row, state, &pins))?;
+        let mut w = can(ask(&pins))?;
         for (_, leaf) in self.statuses.iter().filter(|(x, _)| sent.contains(x)) {
             if value_of(self.an, &w.inputs, *leaf) != Some(&not_ready()) {
                 continue;
@@ -203,7 +218,7 @@ impl<'a, 'ir> Walker<'a, 'ir> {
                 }
                 let mut tried = pins.clone();
                 tried.push((*leaf, v.clone()));
-                can(self.an.can_fire_in_given(row, state, &tried)).map(|w| (tried, w))
+                can(ask(&tried)).map(|w| (tried, w))
             })?;
             (pins, w) = answered;
         }
@@ -221,55 +236,22 @@ impl<'a, 'ir> Walker<'a, 'ir> {
             path: Vec::new(),
         }];
         let mut all = layer.clone();
-        let depth = (self.plan.states.len() + 2).min(MAX_DEPTH);
-        for _ in 0..depth {
+        for _ in 0..self.depth() {
             let mut next: Vec<Place> = Vec::new();
             for at in &layer {
-                for (i, row) in self.plan.rows.iter().enumerate() {
+                let moves = (0..self.plan.rows.len()).map(Some).chain([None]);
+                for row in moves {
                     if next.len() >= MAX_WIDTH {
                         break;
                     }
-                    if !covers(&row.from, at.state) || self.an.never_fires_in(i, at.state) {
-                        continue;
-                    }
-                    let Some(state) = target_state(row, at.state) else {
+                    let Some(to) = self.step(at, row) else {
                         continue;
                     };
-                    let pins = self.pins(at.state_cycles, at.plan_cycles, at);
-                    let Some(w) = self.fire(i, at.state, &pins, &at.sent) else {
-                        continue;
-                    };
-                    let mut to = at.clone();
-                    to.state = state;
-                    to.state_cycles = if state == at.state {
-                        at.state_cycles.saturating_add(1)
-                    } else {
-                        1
-                    };
-                    to.plan_cycles += 1;
-                    for l in self.an.command_leaves() {
-                        if let (Some(v), false) = (
-                            value_of(self.an, &w.inputs, l),
-                            to.pinned.iter().any(|(p, _)| *p == l),
-                        ) {
-                            to.pinned.push((l, v.clone()));
-                        }
-                    }
-                    for x in sends(row) {
-                        if !to.sent.contains(&x) {
-                            to.sent.push(x);
-                        }
-                    }
-                    to.path.push(Step {
-                        row: i,
-                        state: at.state,
-                        inputs: w.inputs,
-                    });
                     let same = |p: &Place| {
                         p.state == to.state
                             && p.state_cycles == to.state_cycles
                             && p.sent == to.sent
-                            && p.path.last().map(|s| s.row) == Some(i)
+                            && p.path.last().map(|s| s.row) == Some(row)
                     };
                     if !next.iter().any(same) {
                         next.push(to);
@@ -280,6 +262,75 @@ impl<'a, 'ir> Walker<'a, 'ir> {
             layer = next;
         }
         all
+    }
+
+    /// How many cycles walks take: enough to visit every state and to wait
+    /// past the largest `state_cycles` constant, within [`MAX_DEPTH`].
+    fn depth(&self) -> usize {
+        let longest_wait = self.counters[1].map_or(0, |sc| {
+            self.an
+                .cell_values(sc)
+                .iter()
+                .filter_map(|v| match v {
+                    Value::Int(i) => usize::try_from(*i).ok(),
+                    _ => None,
+                })
+                .max()
+                .unwrap_or(0)
+        });
+        (self.plan.states.len() + 2)
+            .saturating_add(longest_wait)
+            .min(MAX_DEPTH)
+    }
+
+    /// Where one cycle from `at` leads: row `row` fires, or (`None`) no
+    /// row does and the plan waits. `None` when the analysis cannot show
+    /// it happening.
+    fn step(&self, at: &Place, row: Option<usize>) -> Option<Place> {
+        let pins = self.pins(at.state_cycles, at.plan_cycles, at);
+        let (state, w) = match row {
+            Some(i) => {
+                let r = &self.plan.rows[i];
+                if !covers(&r.from, at.state) || self.an.never_fires_in(i, at.state) {
+                    return None;
+                }
+                let state = target_state(r, at.state)?;
+                (state, self.fire(i, at.state, &pins, &at.sent)?)
+            }
+            None => {
+                let idle = |pins: &[(LeafId, Value)]| self.an.can_idle_given(at.state, pins);
+                (at.state, self.answered(&pins, &at.sent, idle)?)
+            }
+        };
+        let mut to = at.clone();
+        to.state = state;
+        to.state_cycles = if state == at.state {
+            at.state_cycles.saturating_add(1)
+        } else {
+            1
+        };
+        to.plan_cycles += 1;
+        for l in self.an.command_leaves() {
+            if let (Some(v), false) = (
+                value_of(self.an, &w.inputs, l),
+                to.pinned.iter().any(|(p, _)| *p == l),
+            ) {
+                to.pinned.push((l, v.clone()));
+            }
+        }
+        if let Some(i) = row {
+            for x in sends(&self.plan.rows[i]) {
+                if !to.sent.contains(&x) {
+                    to.sent.push(x);
+                }
+            }
+        }
+        to.path.push(Step {
+            row,
+            state: at.state,
+            inputs: w.inputs,
+        });
+        Some(to)
     }
 
     /// The leaves of `pinned` as leaves, for the caller to replay.

@@ -146,6 +146,15 @@ impl Code {
             Code::Lint(Lint::IncompleteState) => {
                 "with some command values no row of a reachable state can ever fire: the plan hangs"
             }
+            Code::Lint(Lint::Livelock) => {
+                "rows move between states every cycle, so no other row can ever fire"
+            }
+            Code::Lint(Lint::CommandEveryCycle) => {
+                "a command is sent again every cycle while the subordinate executes it"
+            }
+            Code::Lint(Lint::StatusNeverReported) => {
+                "a supervisor waits for a status the subordinate never reports"
+            }
         }
     }
 

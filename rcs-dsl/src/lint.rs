@@ -20,10 +20,13 @@ pub enum Lint {
     Unused,
     UnhandledError,
     IncompleteState,
+    Livelock,
+    CommandEveryCycle,
+    StatusNeverReported,
 }
 
 impl Lint {
-    pub const ALL: [Lint; 11] = [
+    pub const ALL: [Lint; 14] = [
         Lint::RuleOfTen,
         Lint::ShadowedRow,
         Lint::UnreachableState,
@@ -35,6 +38,9 @@ impl Lint {
         Lint::Unused,
         Lint::UnhandledError,
         Lint::IncompleteState,
+        Lint::Livelock,
+        Lint::CommandEveryCycle,
+        Lint::StatusNeverReported,
     ];
 
     pub fn name(self) -> &'static str {
@@ -50,6 +56,9 @@ impl Lint {
             Lint::Unused => "unused",
             Lint::UnhandledError => "unhandled_error",
             Lint::IncompleteState => "incomplete_state",
+            Lint::Livelock => "livelock",
+            Lint::CommandEveryCycle => "command_every_cycle",
+            Lint::StatusNeverReported => "status_never_reported",
         }
     }
 

@@ -38,15 +38,22 @@
 //! the whole procedure is a few hundred lines with no native dependency for
 //! users to install. A node budget ([`search::BUDGET`]) bounds the worst
 //! case: past it, the answer is "unknown".
+//!
+//! Questions over several cycles (a ring of states the plan goes round, a
+//! command sent again on the next cycle) are answered from these one-cycle
+//! questions, along walks from the entry with the counters each walk
+//! implies: [`cycles`].
 
 mod case_text;
 pub mod command;
+pub mod cycles;
 pub mod domain;
 pub mod eval;
 pub mod path;
 pub mod run;
 pub mod search;
 pub mod terms;
+mod walk;
 
 use crate::ir::{Condition, Controller, CtrlId, From, Ir, Plan, StateId, StatusId, Type};
 use rcs_runtime::driver::Value;
@@ -291,23 +298,60 @@ impl<'ir> PlanAnalysis<'ir> {
         self.decide(&f, &fixed, state)
     }
 
+    /// Whether several rows can each fire in their state under one
+    /// assignment of the leaves, with the `given` ones pinned (the caller
+    /// pins the counters and `new_command`, which the firings share): the
+    /// question of rows that fire in turn while the inputs stay the same.
+    pub fn can_fire_all_given(
+        &self,
+        firings: &[(usize, StateId)],
+        given: &[(LeafId, Value)],
+    ) -> Answer {
+        let mut parts = Vec::new();
+        for &(row, state) in firings {
+            match self.fires(row, state) {
+                Some(f) => parts.push(f),
+                None => return Answer::Never,
+            }
+        }
+        let state = firings.first().map_or(StateId::S0, |f| f.1);
+        self.decide(&Formula::And(parts), given, state)
+    }
+
+    /// Whether, in `state`, a cycle can go by with no row firing (the plan
+    /// waits), with the `given` leaves pinned: no row covering `state`
+    /// matches, and the plan has no `otherwise`.
+    pub fn can_idle_given(&self, state: StateId, given: &[(LeafId, Value)]) -> Answer {
+        let Some(any) = self.conditions_covering(state) else {
+            return Answer::Never;
+        };
+        let mut fixed = self.fixed(state);
+        fixed.extend(given.iter().cloned());
+        self.decide(&Formula::Not(Box::new(Formula::Or(any))), &fixed, state)
+    }
+
     /// Whether no row covering `state` can match, whatever the leaves not
     /// in `given` are: the plan cannot leave `state` (nor run any job
     /// there) while the `given` values hold. A proof: `false` when unknown.
     pub fn nothing_matches_given(&self, state: StateId, given: &[(LeafId, Value)]) -> bool {
-        let mut any = Vec::new();
-        for (i, row) in self.plan.rows.iter().enumerate() {
-            if covers(&row.from, state) {
-                match &self.conds[i] {
-                    Some(c) => any.push(Formula::Shared(c.clone())),
-                    // An `otherwise` row matches when nothing else does.
-                    None => return false,
-                }
-            }
-        }
+        let Some(any) = self.conditions_covering(state) else {
+            return false;
+        };
         let mut fixed = self.fixed(state);
         fixed.extend(given.iter().cloned());
         matches!(self.prove(&Formula::Or(any), &fixed), Outcome::None)
+    }
+
+    /// The conditions of the rows covering `state`; `None` when an
+    /// `otherwise` row covers it (it matches when nothing else does).
+    fn conditions_covering(&self, state: StateId) -> Option<Vec<Formula>> {
+        let mut any = Vec::new();
+        for (i, row) in self.plan.rows.iter().enumerate() {
+            if covers(&row.from, state) {
+                any.push(Formula::Shared(self.conds[i].clone()?));
+            }
+        }
+        Some(any)
     }
 
     fn proves_never(&self, q: Question) -> bool {

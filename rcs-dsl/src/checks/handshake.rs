@@ -148,3 +148,181 @@ fn is_done_test(e: &Expr, x: CtrlId) -> bool {
         _ => false,
     }
 }
+
+/// `status_never_reported`: a supervisor tests `X.status == S` (or
+/// `X.done`) although no row of X that can fire, in the plans X runs for
+/// the verbs the supervisor sends it, reports `S`. `EXECUTING` and
+/// `NOT_READY` come from the handshake, never from a row, and a test of
+/// `ERROR` is defensive handling: those three are not judged.
+pub(crate) fn check_status_never_reported(ir: &Ir, plans: &Plans, sink: &mut Sink) {
+    for (ci, c) in ir.controllers.iter().enumerate() {
+        for &x in &c.subordinates {
+            // One supervisor only commands X (two is an error of its own).
+            if ir.controller(x).supervisor != Some(CtrlId(ci as u32)) {
+                continue;
+            }
+            let sent: Vec<CommandId> = c.plans.iter().flat_map(|p| verbs_sent(&p.rows, x)).fold(
+                Vec::new(),
+                |mut vs, v| {
+                    if !vs.contains(&v) {
+                        vs.push(v);
+                    }
+                    vs
+                },
+            );
+            let Some(reported) = statuses_reported(ir, plans, x, &sent) else {
+                continue;
+            };
+            for p in &c.plans {
+                for r in &p.rows {
+                    for (status, span) in status_tests(r, x) {
+                        // ERROR is not judged: testing it is the
+                        // defensive handling `unhandled_error` asks for,
+                        // worth keeping when X's plans change.
+                        if status == StatusId::NOT_READY
+                            || status == StatusId::EXECUTING
+                            || status == StatusId::ERROR
+                            || reported.contains(&status)
+                        {
+                            continue;
+                        }
+                        let d = never_reported(ir, c, x, &sent, status, span);
+                        sink.lint(Some(c), Some(p), d);
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn never_reported(
+    ir: &Ir,
+    c: &crate::ir::Controller,
+    x: CtrlId,
+    sent: &[CommandId],
+    status: StatusId,
+    span: crate::source::Span,
+) -> Diagnostic {
+    let xc = ir.controller(x);
+    let sub = &xc.name;
+    let name = &xc.statuses[status.index()].name;
+    let verbs: Vec<String> = sent
+        .iter()
+        .map(|v| format!("`{}`", xc.commands[v.index()].name))
+        .collect();
+    let how = match status {
+        StatusId::DONE => "ends in `Done`".to_string(),
+        _ => format!("has `report {name}`"),
+    };
+    let note = if sent.is_empty() {
+        format!(
+            "`{}` never sends `{sub}` a command, so `{sub}` shows `NOT_READY` for ever",
+            c.name
+        )
+    } else {
+        let plural = if verbs.len() == 1 { "" } else { "s" };
+        let verbs = verbs.join(", ");
+        format!(
+            "`{}` sends `{sub}` {verbs}; in `{sub}`'s plan{plural} for {verbs}, no row that can \
+             fire {how}",
+            c.name
+        )
+    };
+    Diagnostic::lint(
+        Lint::StatusNeverReported,
+        format!(
+            "`{}` waits for `{sub}` to report `{name}`, which it never does",
+            c.name
+        ),
+        span,
+        format!("`{sub}` never reports `{name}`"),
+    )
+    .with_note(note)
+    .with_help(if status == StatusId::DONE {
+        format!("test a status `{sub}` reports, or give `{sub}`'s plan a way to `Done`")
+    } else {
+        format!("test a status `{sub}` reports, or make a row of `{sub}` report `{name}`")
+    })
+}
+
+/// The statuses the rows of `x` that can fire report, in the plans `x`
+/// runs for `verbs`; `None` when a verb has no plan (nothing to judge).
+fn statuses_reported(
+    ir: &Ir,
+    plans: &Plans,
+    x: CtrlId,
+    verbs: &[CommandId],
+) -> Option<Vec<StatusId>> {
+    let mut reported = Vec::new();
+    let mut add = |s: StatusId| {
+        if !reported.contains(&s) {
+            reported.push(s);
+        }
+    };
+    for v in verbs {
+        let pid = ir.controller(x).commands[v.index()].plan?.index();
+        let plan = &ir.controller(x).plans[pid];
+        let graph = &plans.graphs[x.index()][pid];
+        let conditions = &plans.conditions[x.index()][pid];
+        for (i, r) in plan.rows.iter().enumerate() {
+            let can_fire = !graph.never_matches[i]
+                && (0..plan.states.len()).any(|s| {
+                    graph.reachable[s] && !conditions.never_fires_in(i, StateId(s as u32))
+                });
+            if !can_fire {
+                continue;
+            }
+            match r.to {
+                Target::Done => add(StatusId::DONE),
+                Target::Error(_) => add(StatusId::ERROR),
+                Target::State(_) | Target::Same => {}
+            }
+            for j in &r.jobs {
+                if let Job::Report { status, .. } = j {
+                    add(*status);
+                }
+            }
+        }
+    }
+    Some(reported)
+}
+
+/// The statuses of `x` a row's condition waits for, with the test's span:
+/// `x.done`, `x.error`, `x.status == S` (either way round), where the
+/// condition holds only if the test does (not under a `!`).
+fn status_tests(r: &Row, x: CtrlId) -> Vec<(StatusId, crate::source::Span)> {
+    let mut found = Vec::new();
+    if let crate::ir::Condition::When(e) = &r.cond {
+        waits_in(e, x, &mut found);
+    }
+    found
+}
+
+fn waits_in(e: &Expr, x: CtrlId, found: &mut Vec<(StatusId, crate::source::Span)>) {
+    let status_of_x = |e: &Expr| matches!(e.kind, ExprKind::Sub(c, SubProp::Status) if c == x);
+    let constant = |e: &Expr| match e.kind {
+        ExprKind::Status(s) => Some(s),
+        _ => None,
+    };
+    match &e.kind {
+        ExprKind::Sub(c, SubProp::Done) if *c == x => found.push((StatusId::DONE, e.span)),
+        ExprKind::Sub(c, SubProp::Error) if *c == x => found.push((StatusId::ERROR, e.span)),
+        ExprKind::Binary(BinOp::And | BinOp::Or, l, r) => {
+            waits_in(l, x, found);
+            waits_in(r, x, found);
+        }
+        ExprKind::Binary(BinOp::Eq, l, r) => {
+            let tested = if status_of_x(l) {
+                constant(r)
+            } else if status_of_x(r) {
+                constant(l)
+            } else {
+                None
+            };
+            if let Some(s) = tested {
+                found.push((s, e.span));
+            }
+        }
+        _ => {}
+    }
+}

@@ -7,6 +7,7 @@ mod graph;
 mod handshake;
 mod hang;
 mod hierarchy;
+mod loops;
 mod plan;
 mod usage;
 
@@ -108,10 +109,13 @@ pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagno
             graph::check_dead_ends(c, p, analysis, &mut sink);
             graph::check_no_done(ir, c, p, analysis, &mut sink);
             hang::check_incomplete_states(c, p, conditions, analysis, &mut sink);
+            loops::check_livelocks(c, p, conditions, &mut sink);
+            loops::check_command_storms(ir, c, p, conditions, &mut sink);
         }
     }
     let plans = handshake::Plans { conditions, graphs };
     handshake::check_unhandled_error(ir, &plans, &mut sink);
+    handshake::check_status_never_reported(ir, &plans, &mut sink);
     hierarchy::check_span_of_control(ir, &mut sink);
     hierarchy::check_level_order(ir, &mut sink);
     usage::check_float_equality(ir, &mut sink);

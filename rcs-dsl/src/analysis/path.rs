@@ -167,6 +167,42 @@ impl PlanAnalysis<'_> {
         self.extend(prefix, witness, cycles, expect)
     }
 
+    /// A run for a finding in `state` that holds with the command's
+    /// parameters at `params`: the way there with them pinned, then `held`
+    /// for `cycles` cycles that must show `expect`. `None` when no way
+    /// there is found, or the replay does not show `expect`.
+    pub fn finding_run(
+        &self,
+        params: &[(Leaf, Value)],
+        state: StateId,
+        held: &[(Leaf, Value)],
+        cycles: u32,
+        expect: Expect,
+    ) -> Option<Run> {
+        let given: Vec<(LeafId, Value)> = params
+            .iter()
+            .filter_map(|(l, v)| Some((self.terms.find(l)?, v.clone())))
+            .collect();
+        let paths = self.paths_given(&given);
+        let prefix = paths.get(state.index())?.as_ref()?;
+        let mut inputs = held.to_vec();
+        if prefix.steps.is_empty() {
+            // In `S0` before any cycle: the step starts with the command,
+            // whose first cycle only a hang (nothing fires from the start)
+            // shares with the cycles after it.
+            if !matches!(expect, Expect::Stays { .. }) {
+                return None;
+            }
+            inputs.extend(params.iter().cloned());
+        }
+        let witness = Witness {
+            state,
+            inputs,
+            shown: Vec::new(),
+        };
+        self.extend(prefix, &witness, cycles, expect)
+    }
+
     /// `prefix` and one more step: `witness`'s inputs that a scenario can
     /// set, held for `cycles` cycles that must show `expect`. `None` when
     /// the witness needs what a scenario cannot set (a hook called with

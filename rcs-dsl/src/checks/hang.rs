@@ -97,6 +97,16 @@ pub(crate) fn check_incomplete_states(
             None => {}
         }
         d = d.with_witness(name, &shown);
+        // The run: the way in with these values, then 30 cycles of nothing.
+        let params: Vec<_> = hang
+            .command
+            .iter()
+            .map(|(l, v)| (conditions.terms().leaves[*l].0.clone(), v.clone()))
+            .collect();
+        let expect = crate::analysis::run::Expect::Stays {
+            state: name.clone(),
+        };
+        d = d.with_run(conditions.finding_run(&params, hang.state, &[], 30, expect));
         let rows: Vec<String> = hang
             .path
             .iter()

@@ -100,7 +100,9 @@ pub fn system_module(ir: &Ir, options: &crate::Options) -> String {
             // logic in a plan is the plan's (rcsc's checks report what matters,
             // e.g. `shadowed_row`) and must not fail the user's clippy run.
             // `System` has one type parameter per controller with hooks, so
-            // its types grow with the plan set (`type_complexity`).
+            // its types grow with the plan set (`type_complexity`). A
+            // negated float comparison is the plan's way to include NaN
+            // (`!(x < 0.0)` holds for NaN; `x >= 0.0` does not).
             #![allow(
                 unused_comparisons,
                 clippy::nonminimal_bool,
@@ -114,7 +116,8 @@ pub fn system_module(ir: &Ir, options: &crate::Options) -> String {
                 clippy::absurd_extreme_comparisons,
                 clippy::manual_range_contains,
                 clippy::approx_constant,
-                clippy::type_complexity
+                clippy::type_complexity,
+                clippy::neg_cmp_op_on_partial_ord
             )]
             use ::rcs_runtime as rt;
             #types

@@ -80,7 +80,23 @@ const NEVER_FIRE: &[(&str, &str, &str, u32, &str)] = &[
     (OK_0018, "A", "GO", 11, "S1: reached only through row 0"),
     (OK_0107, "H", "ARGS", 2, "`reading(1) == Mid && reading(2) == Low`: the scripted hooks answer one value per hook, whatever the arguments"),
     (OK_0107, "H", "ARGS", 3, "`reading(2) == Low` after `reading(1) == Low`: one scripted value per hook (see row 2)"),
+    (OK_0114, "A", "GO", 3, "`state_cycles > 50`: `a * b > 10` or `a * b <= 10` always matches first (the analysis leaves products alone, so it says nothing)"),
+    (OK_0115, "A", "GO", 2, "`ok(2)` after `ok(1)`: the scripted hooks answer one value per hook, whatever the arguments"),
+    (OK_0121, "A", "GO", 3, "`state_cycles > 4`: `a < b` or `a >= b` always matches first (two inputs compared: left alone by the analysis)"),
+    (OK_0126, "A", "GO", 2, "`S2 when state_cycles > 5`: plan_cycles is always above state_cycles, so row 3 (`plan_cycles > 5`) ends S2 first"),
+    (OK_0131, "B", "RUN", 1, "`state_cycles > 9`: row 2 (`plan_cycles > 3`) ends RUN first, plan_cycles being at least state_cycles"),
+    (OK_0132, "B", "RUN", 1, "`state_cycles > 20`: row 2 (`plan_cycles > 3`) ends RUN first"),
+    (OK_0133, "A", "GO", 4, "`otherwise`: `x < 0`, `x > 0` and `x == 0` cover every integer"),
+    (OK_0137, "A", "GO", 3, "`plan_cycles > 60`: `reading() > limit` or `reading() <= limit` always matches first"),
 ];
+const OK_0114: &str = "tests/data/ok/0114_analysis_opaque_products.rcs";
+const OK_0115: &str = "tests/data/ok/0115_analysis_hooks_with_different_arguments.rcs";
+const OK_0121: &str = "tests/data/ok/0121_analysis_two_inputs_compared.rcs";
+const OK_0126: &str = "tests/data/ok/0126_analysis_state_then_plan_cycles.rcs";
+const OK_0131: &str = "tests/data/ok/0131_analysis_stale_watchdog_handles_error.rcs";
+const OK_0132: &str = "tests/data/ok/0132_analysis_error_handled_by_timeout.rcs";
+const OK_0133: &str = "tests/data/ok/0133_analysis_three_way_split_then_otherwise.rcs";
+const OK_0137: &str = "tests/data/ok/0137_analysis_hook_compared_with_var.rcs";
 const OK_0009: &str = "tests/data/ok/0009_targets_and_otherwise.rcs";
 const OK_0011: &str = "tests/data/ok/0011_otherwise_never_shadowed.rcs";
 const OK_0017: &str = "tests/data/ok/0017_lint_levels";

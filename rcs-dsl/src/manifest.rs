@@ -12,6 +12,9 @@ use crate::yaml::{self, Spanned};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 
+/// The longest executive period, as the runtime accepts it.
+const MAX_PERIOD_NS: u64 = rcs_runtime::exec::MAX_PERIOD.as_nanos() as u64;
+
 /// The default executive period when the manifest gives no schedule.
 pub const DEFAULT_PERIOD_NS: u64 = 10_000_000;
 
@@ -208,6 +211,18 @@ pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>>
             let period_ns = match &cpu.period {
                 None => DEFAULT_PERIOD_NS,
                 Some(p) => match parse_duration(&p.value) {
+                    Some(ns) if ns > MAX_PERIOD_NS => {
+                        diags.push(
+                            Diagnostic::error(
+                                Code::Manifest,
+                                format!("period `{}` is too long", p.value),
+                                spanned(&p.referenced),
+                                "longer than an hour",
+                            )
+                            .with_help("an executive's period is at most `3600s` (one hour)"),
+                        );
+                        DEFAULT_PERIOD_NS
+                    }
                     Some(ns) if ns > 0 => ns,
                     _ => {
                         diags.push(

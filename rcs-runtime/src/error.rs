@@ -29,4 +29,7 @@ pub enum SetupError {
     /// An executive period of zero.
     #[error("executive `{0}` has a zero period")]
     ZeroPeriod(String),
+    /// An executive period longer than [`MAX_PERIOD`](crate::exec::MAX_PERIOD).
+    #[error("executive `{0}` has a period of {1:?}; the longest accepted is one hour")]
+    PeriodTooLong(String, std::time::Duration),
 }

@@ -85,25 +85,39 @@ impl Default for Wait {
     }
 }
 
+/// The longest heartbeat period an executive accepts: an hour. Deadlines
+/// are instants `start + k × period`; a bound keeps that arithmetic far from
+/// overflow however long the system runs, and no RCS level plans slower.
+pub const MAX_PERIOD: Duration = Duration::from_secs(3600);
+
 /// A periodic clock with absolute deadlines: deadline `k` is `start + k ×
-/// period`, so lateness does not accumulate. A deadline that is already a
-/// whole period past is skipped (counted by the caller as an overrun), and
-/// the schedule restarts from now.
+/// period`, so lateness does not accumulate. Deadlines that have already
+/// passed when a wait begins are *missed*: they are skipped (counted in
+/// [`missed`](Self::missed)), and the schedule restarts from now.
 #[derive(Debug, Clone)]
 pub struct Heartbeat {
     period: Duration,
     wait: Wait,
     next: Option<Instant>,
+    missed: u64,
 }
 
 impl Heartbeat {
-    /// A heartbeat of `period`, waiting with `wait`.
+    /// A heartbeat of `period` (at most [`MAX_PERIOD`]; a longer one is cut
+    /// to it), waiting with `wait`.
     pub fn new(period: Duration, wait: Wait) -> Self {
         Self {
-            period,
+            period: period.min(MAX_PERIOD),
             wait,
             next: None,
+            missed: 0,
         }
+    }
+
+    /// Deadlines skipped so far because a cycle (or the machine) ran past
+    /// them: a cycle that overran by three periods misses two heartbeats.
+    pub fn missed(&self) -> u64 {
+        self.missed
     }
 
     /// Start the schedule: the first deadline is one period after `now`.
@@ -140,6 +154,12 @@ impl Heartbeat {
         }
         let mut next = deadline + self.period;
         if next <= woke {
+            // Every deadline in (deadline, woke] was missed.
+            let behind = woke.saturating_duration_since(deadline).as_nanos();
+            let missed = behind / self.period.as_nanos().max(1);
+            self.missed = self
+                .missed
+                .saturating_add(u64::try_from(missed).unwrap_or(u64::MAX));
             next = woke + self.period;
         }
         self.next = Some(next);
@@ -169,6 +189,10 @@ pub struct ExecutiveStats {
     pub cycles: u64,
     /// Cycles whose controllers together took longer than the period.
     pub overruns: u64,
+    /// Heartbeats skipped because a cycle (or the machine) ran past their
+    /// deadline (only in [`Executive::run`]): a cycle that takes three
+    /// periods is one overrun and two missed heartbeats.
+    pub missed_heartbeats: u64,
     /// Duration of a whole cycle (all controllers), nanoseconds.
     pub cycle_ns: SampleStats,
     /// How late each heartbeat woke after its deadline, nanoseconds (only
@@ -223,6 +247,7 @@ struct Shared {
     stop: AtomicBool,
     cycle: AtomicU64,
     overruns: AtomicU64,
+    missed: AtomicU64,
 }
 
 /// Remote control of an executive, usable from any thread (the operator's
@@ -268,6 +293,10 @@ impl ExecutiveHandle {
     /// Overruns counted so far.
     pub fn overruns(&self) -> u64 {
         self.shared.overruns.load(Ordering::Acquire)
+    }
+    /// Heartbeats missed so far (see [`ExecutiveStats::missed_heartbeats`]).
+    pub fn missed_heartbeats(&self) -> u64 {
+        self.shared.missed.load(Ordering::Acquire)
     }
     /// Single steps requested and not yet run.
     pub fn pending_steps(&self) -> u64 {
@@ -315,6 +344,9 @@ impl Executive {
     pub fn new(config: ExecutiveConfig) -> Result<Self, SetupError> {
         if config.period.is_zero() {
             return Err(SetupError::ZeroPeriod(config.name));
+        }
+        if config.period > MAX_PERIOD {
+            return Err(SetupError::PeriodTooLong(config.name, config.period));
         }
         Ok(Self {
             heartbeat: Heartbeat::new(config.period, config.wait),
@@ -414,6 +446,10 @@ impl Executive {
             }
             let late = self.heartbeat.wait();
             self.stats.lateness_ns.record(nanos(late));
+            self.stats.missed_heartbeats = self.heartbeat.missed();
+            self.shared
+                .missed
+                .store(self.heartbeat.missed(), Ordering::Release);
         }
     }
 
@@ -533,6 +569,32 @@ impl Executive {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_period_past_the_bound_is_refused_at_construction() {
+        let e = Executive::new(ExecutiveConfig::new("cpu", Duration::MAX));
+        assert!(matches!(e, Err(SetupError::PeriodTooLong(..))), "{e:?}");
+        assert!(Executive::new(ExecutiveConfig::new("cpu", MAX_PERIOD)).is_ok());
+        // A heartbeat built directly is cut to the bound, not left to overflow.
+        assert_eq!(
+            Heartbeat::new(Duration::MAX, Wait::Sleep).period(),
+            MAX_PERIOD
+        );
+    }
+
+    #[test]
+    fn deadlines_already_past_are_counted_as_missed() {
+        // Started 50 ms ago with a 1 ms period: the first deadline is 49 ms
+        // past when the wait begins, and every deadline up to now is missed.
+        let period = Duration::from_millis(1);
+        let mut hb = Heartbeat::new(period, Wait::Sleep);
+        let Some(start) = Instant::now().checked_sub(Duration::from_millis(50)) else {
+            return;
+        };
+        hb.start(start);
+        hb.wait();
+        assert!(hb.missed() >= 48, "missed {}", hb.missed());
+    }
+
     use super::*;
 
     #[test]

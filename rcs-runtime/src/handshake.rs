@@ -188,6 +188,7 @@ pub struct SubordinateLink {
     last_sent: u32,
     seen_generation: u64,
     view: SubordinateView,
+    old_echoes: u64,
 }
 
 impl Default for SubordinateLink {
@@ -214,6 +215,7 @@ impl SubordinateLink {
                     state: 0,
                 },
             },
+            old_echoes: 0,
         }
     }
 
@@ -237,6 +239,7 @@ impl SubordinateLink {
             (raw.status, raw.error)
         } else {
             // A status for an older command never counts for the newer one.
+            self.old_echoes = self.old_echoes.saturating_add(1);
             (Status::EXECUTING, ErrorCode::NONE)
         };
         // Field by field: a whole-struct store is built on the stack with
@@ -258,6 +261,17 @@ impl SubordinateLink {
     #[inline]
     pub fn view(&self) -> SubordinateView {
         self.view
+    }
+
+    /// Cycles whose read showed an older serial than the last one sent (the
+    /// supervisor saw EXECUTING in their place). A cycle or two after each
+    /// command is the subordinate picking it up; a count that grows every
+    /// cycle is a subordinate that answers but does not take the commands
+    /// (a stale echo), which `stale_cycles` cannot show since it keeps
+    /// writing.
+    #[inline]
+    pub fn old_echoes(&self) -> u64 {
+        self.old_echoes
     }
 
     /// Allocate the serial of a new command to this subordinate and remember
@@ -434,6 +448,24 @@ mod tests {
         let v = l.observe(&stamped(s2, Status::ERROR, 4));
         assert!(v.error());
         assert_eq!(v.error, ErrorCode::custom(0));
+    }
+
+    #[test]
+    fn a_stale_echo_every_cycle_is_counted() {
+        // The subordinate writes its status every cycle (so `stale_cycles`
+        // stays 0) but keeps echoing the command before the last one.
+        let mut link = SubordinateLink::new();
+        let first = link.next_command();
+        let v = link.observe(&stamped(first, Status::DONE, 1));
+        assert_eq!(v.status, Status::DONE);
+        assert_eq!(link.old_echoes(), 0);
+        link.next_command();
+        for g in 2..12 {
+            let v = link.observe(&stamped(first, Status::DONE, g));
+            assert_eq!(v.stale_cycles, 0);
+            assert_eq!(v.status, Status::EXECUTING);
+        }
+        assert_eq!(link.old_echoes(), 10);
     }
 
     #[test]

@@ -64,6 +64,13 @@ impl<C: Command> Operator<C> {
         (v.done() || v.error()).then_some((v.status, v.error))
     }
 
+    /// Cycles (reads of [`view`](Self::view)) in which the root showed an
+    /// older serial than the last one sent: see
+    /// [`SubordinateLink::old_echoes`](crate::SubordinateLink::old_echoes).
+    pub fn old_echoes(&self) -> u64 {
+        self.link.old_echoes()
+    }
+
     /// Serial of the last command sent (0: none).
     pub fn last_serial(&self) -> u32 {
         self.link.last_sent()

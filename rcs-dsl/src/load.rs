@@ -127,10 +127,7 @@ impl PlanSet {
         match String::from_utf8(bytes) {
             Ok(text) => self.sources.add(display, text),
             Err(e) => {
-                let offset = e.utf8_error().valid_up_to();
-                let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
-                // The lossy text has the same prefix, so the offset is valid in it.
-                let id = self.sources.add(display.clone(), text);
+                let (id, offset) = self.add_lossy(display.clone(), &e);
                 self.diagnostics.push(
                     Diagnostic::error(
                         Code::Syntax,
@@ -417,17 +414,37 @@ impl PlanSet {
         let bytes = read(path)?;
         match String::from_utf8(bytes) {
             Ok(text) => self.add_manifest(&display(path), text),
-            Err(_) => {
-                let id = self.sources.add(display(path), String::new());
-                self.diagnostics.push(Diagnostic::error(
-                    Code::Manifest,
-                    "`rcs.yaml` is not valid UTF-8",
-                    Span::new(id, 0, 0),
-                    "this file",
-                ));
+            Err(e) => {
+                // Shown, not read: the manifest's settings are left out.
+                let (id, offset) = self.add_lossy(display(path), &e);
+                self.diagnostics.push(
+                    Diagnostic::error(
+                        Code::Manifest,
+                        format!(
+                            "`rcs.yaml` is not valid UTF-8 (first bad byte at offset {offset})"
+                        ),
+                        Span::new(id, offset, offset + '\u{FFFD}'.len_utf8()),
+                        "invalid UTF-8 here",
+                    )
+                    .with_help("save the file as UTF-8"),
+                );
             }
         }
         Ok(())
+    }
+
+    /// A file that is not valid UTF-8, added with U+FFFD for each bad
+    /// sequence so that it can be shown; with the offset of the first bad
+    /// byte in the added text.
+    fn add_lossy(&mut self, display: String, e: &std::string::FromUtf8Error) -> (FileId, usize) {
+        let mut offset = e.utf8_error().valid_up_to();
+        let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
+        // The lossy text has the same prefix, so the offset is valid in it,
+        // less the byte-order mark the source map drops.
+        if text.starts_with(crate::source::BOM) {
+            offset -= crate::source::BOM.len_utf8();
+        }
+        (self.sources.add(display, text), offset)
     }
 
     /// Read one `.rcs` file into the set.

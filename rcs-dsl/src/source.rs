@@ -42,6 +42,9 @@ impl Span {
     }
 }
 
+/// The byte-order mark some editors put at the start of a UTF-8 file.
+pub const BOM: char = '\u{FEFF}';
+
 /// One input file: its display path (relative to the plan set's root, with
 /// `/` separators) and its text.
 #[derive(Clone, Debug)]
@@ -52,10 +55,20 @@ pub struct SourceFile {
 }
 
 impl SourceFile {
+    /// A file from its text. A leading byte-order mark is dropped (it is
+    /// no character of the file, and would shift every column of line 1);
+    /// lines end at `\n`, `\r\n` or a lone `\r`.
     pub fn new(path: impl Into<String>, text: impl Into<String>) -> SourceFile {
-        let text = text.into();
+        let mut text = text.into();
+        if text.starts_with(BOM) {
+            text.drain(..BOM.len_utf8());
+        }
+        let bytes = text.as_bytes();
         let line_starts = std::iter::once(0)
-            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+            .chain(bytes.iter().enumerate().filter_map(|(i, b)| {
+                let ends_line = *b == b'\n' || (*b == b'\r' && bytes.get(i + 1) != Some(&b'\n'));
+                ends_line.then_some(i + 1)
+            }))
             .collect();
         SourceFile {
             path: path.into(),
@@ -124,5 +137,27 @@ impl SourceMap {
     /// uses for "the later declaration".
     pub fn order_key(&self, span: Span) -> (&str, u32) {
         (self.get(span.file).path.as_str(), span.start)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_end_at_lf_crlf_and_a_lone_cr() {
+        let f = SourceFile::new("t", "a\nbb\r\nccc\rdddd\r\re");
+        assert_eq!(f.line_starts(), &[0, 2, 6, 10, 15, 16]);
+        // `e` is on line 6, column 1; the `d`s on line 4.
+        assert_eq!(f.line_col(16), (6, 1));
+        assert_eq!(f.line_col(12), (4, 3));
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_not_a_column() {
+        let f = SourceFile::new("t", "\u{FEFF}ab\ncd");
+        assert_eq!(f.text, "ab\ncd");
+        assert_eq!(f.line_col(1), (1, 2));
+        assert_eq!(f.line_col(3), (2, 1));
     }
 }

@@ -89,7 +89,7 @@ fn check_nesting(file: FileId, text: &str) -> Result<(), Vec<Diagnostic>> {
     while i < bytes.len() {
         match bytes[i] {
             b'/' if bytes.get(i + 1) == Some(&b'/') => {
-                while i < bytes.len() && bytes[i] != b'\n' {
+                while i < bytes.len() && bytes[i] != b'\n' && bytes[i] != b'\r' {
                     i += 1;
                 }
             }
@@ -114,7 +114,7 @@ fn check_nesting(file: FileId, text: &str) -> Result<(), Vec<Diagnostic>> {
             b'"' => {
                 let start = i;
                 i += 1;
-                while i < bytes.len() && bytes[i] != b'"' && bytes[i] != b'\n' {
+                while i < bytes.len() && !matches!(bytes[i], b'"' | b'\n' | b'\r') {
                     if bytes[i] == b'\\' {
                         i += 1;
                     }

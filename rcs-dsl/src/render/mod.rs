@@ -7,6 +7,8 @@
 
 use crate::diagnostic::{Diagnostic, Severity};
 use crate::source::{FileId, SourceMap, Span};
+mod long_lines;
+
 use codespan_reporting::diagnostic as cs;
 use codespan_reporting::files::{Error as FilesError, Files};
 use codespan_reporting::term;
@@ -109,6 +111,27 @@ fn to_codespan(d: &Diagnostic) -> cs::Diagnostic<FileId> {
 }
 
 fn human(d: &Diagnostic, sources: &SourceMap, color: bool) -> String {
+    let shown = if long_lines::needed(d, sources) {
+        // Long lines cut around the labels, the labels moved to match.
+        let cut = long_lines::CutFiles::new(d, sources);
+        let mut moved = d.clone();
+        for l in &mut moved.labels {
+            let f = l.span.file;
+            let (start, end) = (l.span.start as usize, l.span.end as usize);
+            l.span = Span::new(f, cut.shown_offset(f, start), cut.shown_offset(f, end));
+        }
+        emit(&moved, &cut, color)
+    } else {
+        emit(d, sources, color)
+    };
+    shown.unwrap_or_else(|| short(d, sources))
+}
+
+/// `d` as a rustc-like snippet over `files`, `None` if codespan fails.
+fn emit<'f, F>(d: &Diagnostic, files: &'f F, color: bool) -> Option<String>
+where
+    F: Files<'f, FileId = FileId>,
+{
     let config = term::Config {
         chars: term::Chars::ascii(),
         ..term::Config::default()
@@ -119,13 +142,13 @@ fn human(d: &Diagnostic, sources: &SourceMap, color: bool) -> String {
         let mut ansi = term::termcolor::Ansi::new(Vec::new());
         let ok = {
             let mut w = term::StylesWriter::new(&mut ansi, &styles);
-            term::emit_to_write_style(&mut w, &config, sources, &diag).is_ok()
+            term::emit_to_write_style(&mut w, &config, files, &diag).is_ok()
         };
         if ok {
-            return String::from_utf8_lossy(&ansi.into_inner()).into_owned();
+            return Some(String::from_utf8_lossy(&ansi.into_inner()).into_owned());
         }
     }
-    term::emit_into_string(&config, sources, &diag).unwrap_or_else(|_| short(d, sources))
+    term::emit_into_string(&config, files, &diag).ok()
 }
 
 fn short(d: &Diagnostic, sources: &SourceMap) -> String {

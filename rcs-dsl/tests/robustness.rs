@@ -204,8 +204,20 @@ fn apply(text: &str, muts: &[Mutation]) -> String {
     s
 }
 
+/// Cases per property: 300, or `RCSC_FUZZ_CASES` for a long run (README,
+/// "Fuzzing").
+fn fuzz_cases() -> u32 {
+    std::env::var("RCSC_FUZZ_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(300)
+}
+
+const SCENARIO: &str =
+    include_str!("../../plans/submarine/scenarios/pr_ahead_turbine_error.scenario.yaml");
+
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: fuzz_cases(), ..ProptestConfig::default() })]
 
     #[test]
     fn random_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..2000)) {
@@ -233,10 +245,29 @@ proptest! {
     }
 
     #[test]
+    fn mutated_scenarios_never_panic(muts in proptest::collection::vec(mutation(), 1..8)) {
+        let ir = submarine_ir();
+        let text = apply(SCENARIO, &muts);
+        let file = rcs_dsl::source::SourceFile::new("fuzz.scenario.yaml", text);
+        if let Err(e) = rcs_dsl::scenario::parse(&ir, &file, "fuzz") {
+            // A refusal says where, inside the file.
+            prop_assert!(e.line <= file.line_starts().len() + 1, "{e:?}");
+        }
+    }
+
+    #[test]
     fn mutated_figure13_never_panics(muts in proptest::collection::vec(mutation(), 1..8)) {
         let text = apply(FIGURE13, &muts);
         check_texts(&[("figure13.rcs", &text)], None);
     }
+}
+
+/// The submarine plans, lowered once per test thread.
+fn submarine_ir() -> rcs_dsl::ir::Ir {
+    let set = PlanSet::from_texts("submarine", SUBMARINE.iter().copied(), Some(SUBMARINE_YAML));
+    check(&set, &Options::default())
+        .ir
+        .unwrap_or_else(|| panic!("the submarine plans check"))
 }
 
 #[test]

@@ -166,7 +166,9 @@ fn every_diagnostic_code_has_a_section_and_an_example() {
         if !doc.contains(&format!("#### `{name}`\n")) {
             missing.push(format!("no `#### `{name}`` section"));
         }
-        if !shown.contains(name) {
+        // `too_large` needs 65,536 of something: its example is shown as
+        // text, and `rcs-dsl/tests/limits.rs` checks it.
+        if !shown.contains(name) && name != "too_large" {
             missing.push(format!("no `expect={name}` example"));
         }
     }

@@ -7,6 +7,7 @@ mod graph;
 mod handshake;
 mod hang;
 mod hierarchy;
+mod limits;
 mod loops;
 mod plan;
 mod usage;
@@ -87,6 +88,10 @@ enum Source {
 pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagnostics) {
     let start = diags.len();
     let mut sink = Sink { levels, diags };
+    if limits::check_limits(ir, &mut sink) {
+        diags.sort_from(start, sources);
+        return;
+    }
     plan::check_missing_plans(ir, &mut sink);
     // The analysis of every plan's conditions and its graph first: the
     // checks of a plan ask its own, the handshake checks their

@@ -384,7 +384,13 @@ fn test(args: TestArgs) -> ExitCode {
             .or_else(|| std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from))
             .unwrap_or_else(|| PathBuf::from("target"));
         let refs: Vec<&rcs_dsl::ir::Ir> = irs.iter().collect();
-        match compiled::build(&refs, &target, &test_cmd::status_fn(&status)) {
+        let mut blocked = |dir: &std::path::Path| {
+            status.line(
+                "Blocking",
+                format!("waiting for file lock on {}", rcs_dsl::load::display(dir)),
+            )
+        };
+        match compiled::build(&refs, &target, &test_cmd::status_fn(&status), &mut blocked) {
             Ok(d) => driver = Some(d),
             Err(reason) => return fail(reason),
         }
@@ -636,7 +642,13 @@ fn build(args: BuildArgs) -> ExitCode {
     if !args.no_rustfmt {
         rcs_codegen::rustfmt::format_files(&mut files);
     }
-    let report = match rcs_codegen::writer::write_tree(&args.out_dir, &files) {
+    let mut blocked = |dir: &std::path::Path| {
+        status.line(
+            "Blocking",
+            format!("waiting for file lock on {}", rcs_dsl::load::display(dir)),
+        )
+    };
+    let report = match rcs_codegen::writer::write_tree(&args.out_dir, &files, &mut blocked) {
         Ok(report) => report,
         Err(e) => return fail(e),
     };

@@ -51,12 +51,13 @@ pub enum Code {
     BufferTypeConflict,
     Manifest,
     LooseFile,
+    CaseCollision,
     Lint(Lint),
 }
 
 impl Code {
     /// Every hard-error code, in catalogue order (lints follow in [`Lint::ALL`]).
-    pub const ERRORS: [Code; 21] = [
+    pub const ERRORS: [Code; 22] = [
         Code::Syntax,
         Code::DuplicateDefinition,
         Code::UnknownName,
@@ -78,6 +79,7 @@ impl Code {
         Code::BufferTypeConflict,
         Code::Manifest,
         Code::LooseFile,
+        Code::CaseCollision,
     ];
 
     pub fn name(self) -> &'static str {
@@ -103,6 +105,7 @@ impl Code {
             Code::BufferTypeConflict => "buffer_type_conflict",
             Code::Manifest => "manifest",
             Code::LooseFile => "loose_file",
+            Code::CaseCollision => "case_collision",
             Code::Lint(l) => l.name(),
         }
     }
@@ -131,6 +134,9 @@ impl Code {
             Code::BufferTypeConflict => "one buffer name has two types",
             Code::Manifest => "`rcs.yaml` is malformed",
             Code::LooseFile => "a `.rcs` file stands beside plan-set folders",
+            Code::CaseCollision => {
+                "two names differ only in case where they become one output file name"
+            }
             Code::Lint(Lint::RuleOfTen) => "a plan has more rows than the rule of ten allows",
             Code::Lint(Lint::ShadowedRow) => "earlier rows always match before this row",
             Code::Lint(Lint::UnreachableState) => "no path from the entry reaches a state",

@@ -39,7 +39,8 @@
 //! the folder is mixed, and the journal's presence says so. A build killed
 //! before the journal exists leaves the old outputs whole, plus temporaries
 //! the next write removes. Files are not `fsync`ed: a power cut (unlike a
-//! killed process) may lose recent writes, as with cargo's own outputs.
+//! killed process) may lose recent writes (durability would cost an fsync
+//! per file and folder).
 //! Checks and writes are separate steps, so another program (not rcsc,
 //! which takes the lock) changing the folder between them is not guarded
 //! against.

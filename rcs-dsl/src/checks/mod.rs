@@ -6,6 +6,7 @@
 mod graph;
 mod handshake;
 mod hierarchy;
+pub(crate) mod names;
 mod plan;
 mod usage;
 
@@ -86,6 +87,7 @@ pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagno
     let start = diags.len();
     let mut sink = Sink { levels, diags };
     plan::check_missing_plans(ir, &mut sink);
+    names::check_case_collisions(ir, &mut sink);
     // The analysis of every plan's conditions and its graph first: the
     // checks of a plan ask its own, the handshake checks their
     // subordinates'.

@@ -277,3 +277,27 @@ fn a_build_killed_part_way_is_repaired_by_the_next() {
     assert!(outputs == refs[1], "the last version's complete output");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn names_equal_up_to_case_stop_the_build() {
+    let dir = scratch("case", &[]);
+    let set = plan_set(&dir.join("plans"), 1, 0);
+    std::fs::write(
+        set.join("pr.rcs"),
+        "controller Pr {\n    command GO\n    command Go\n    plan GO {\n        *0 when new_command -> Done\n    }\n    plan Go {\n        *0 when new_command -> Done\n    }\n}\ncontroller PR {\n    command GO\n    plan GO {\n        *0 when new_command -> Done\n    }\n}\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let (code, err) = build(&set, &out);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("controllers `Pr` and `PR` differ only in case"),
+        "{err}"
+    );
+    assert!(
+        err.contains("verbs `GO` and `Go` of `Pr` differ only in case"),
+        "{err}"
+    );
+    assert!(!out.exists(), "nothing written");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -3,7 +3,7 @@
 //! symbolic links are followed), that a file it would replace or remove is
 //! one rcsc generated, and which generated files are stale.
 
-use super::{io_err, WriteError, MAX_DEPTH, RESERVED_PREFIX};
+use super::{io_err, WriteError, JOURNAL_FILE, LOCK_FILE, MAX_DEPTH, RESERVED_PREFIX};
 use crate::GENERATED;
 use std::collections::BTreeSet;
 use std::io::{self, Read};
@@ -116,7 +116,7 @@ pub(super) fn find_stale(dir: &Path, keep: &BTreeSet<String>) -> Result<Vec<Stri
             let rel = format!("{rel}{name}");
             // `file_type` does not follow symbolic links: links are skipped.
             let ty = entry.file_type().map_err(|e| io_err(&path, e))?;
-            if ty.is_dir() && depth < MAX_DEPTH {
+            if ty.is_dir() && depth < MAX_DEPTH && !another_root(&path) {
                 folders.push((path, format!("{rel}/"), depth + 1));
             } else if ty.is_file()
                 && !keep.contains(&rel)
@@ -129,6 +129,15 @@ pub(super) fn find_stale(dir: &Path, keep: &BTreeSet<String>) -> Result<Vec<Stri
     }
     out.sort();
     Ok(out)
+}
+
+/// Whether a folder below the output folder is, right now, the output
+/// folder of another build (it holds that build's lock or journal): the
+/// sweeps leave it to that build.
+pub(super) fn another_root(dir: &Path) -> bool {
+    [LOCK_FILE, JOURNAL_FILE]
+        .iter()
+        .any(|f| std::fs::symlink_metadata(dir.join(f)).is_ok())
 }
 
 /// Whether `rel` is, on a case-insensitive file system, the same file as

@@ -26,7 +26,7 @@
 //! folder is not trusted: it is deleted, and the write that found it
 //! rewrites every file anyway.
 
-use super::{io_err, is_generated, safe_relative, WriteError, JOURNAL_FILE, TMP_PREFIX};
+use super::{guard, io_err, is_generated, safe_relative, WriteError, JOURNAL_FILE, TMP_PREFIX};
 use std::io;
 use std::path::{Path, PathBuf};
 
@@ -156,8 +156,14 @@ pub(super) fn apply(out_dir: &Path, steps: &[Step]) -> Result<Vec<PathBuf>, Writ
 }
 
 /// Finish the build a journal in `out_dir` names, if any (call it with the
-/// lock held, before [`sweep_temporaries`]). Returns whether there was one.
-pub(super) fn recover(out_dir: &Path) -> Result<bool, WriteError> {
+/// lock held, before [`sweep_temporaries`]); `root` is `out_dir`
+/// canonicalised. Returns whether there was one.
+///
+/// What changed in the folder since the journal was written is checked
+/// again: a rename is skipped (its temporary left for the sweep) when its
+/// temporary is no longer a regular file, or when its target now leads out
+/// through a link or holds a file rcsc did not generate.
+pub(super) fn recover(root: &Path, out_dir: &Path) -> Result<bool, WriteError> {
     let path = out_dir.join(JOURNAL_FILE);
     let text = match std::fs::read_to_string(&path) {
         Ok(text) => text,
@@ -166,12 +172,31 @@ pub(super) fn recover(out_dir: &Path) -> Result<bool, WriteError> {
         Err(e) if e.kind() == io::ErrorKind::InvalidData => String::new(),
         Err(e) => return Err(io_err(&path, e)),
     };
-    if let Some(steps) = parse(&text) {
+    if let Some(mut steps) = parse(&text) {
+        steps.retain(|step| match step {
+            Step::Rename(tmp, target) => still_safe(root, out_dir, tmp, target),
+            Step::Remove(_) => true,
+        });
         let removed = apply(out_dir, &steps)?;
         super::remove_emptied_folders(out_dir, &removed);
     }
     finish(out_dir)?;
     Ok(true)
+}
+
+/// Whether a journalled rename may still be carried out.
+fn still_safe(root: &Path, out_dir: &Path, tmp: &str, target: &str) -> bool {
+    let tmp_ok = tmp
+        .rsplit('/')
+        .next()
+        .is_some_and(|name| name.starts_with(TMP_PREFIX))
+        && std::fs::symlink_metadata(out_dir.join(tmp)).is_ok_and(|m| m.is_file());
+    let target_ok = match guard::inspect(root, out_dir, target) {
+        Ok(guard::Existing::Nothing) => true,
+        Ok(guard::Existing::File(bytes)) => guard::first_line_generated(&bytes),
+        Err(_) => false,
+    };
+    tmp_ok && target_ok
 }
 
 /// Remove every temporary below `out_dir` (`.rcsc-tmp-*`, left by a write
@@ -190,7 +215,7 @@ pub(super) fn sweep_temporaries(out_dir: &Path) -> Result<Vec<PathBuf>, WriteErr
             let entry = entry.map_err(|e| io_err(&dir, e))?;
             let path = entry.path();
             let ty = entry.file_type().map_err(|e| io_err(&path, e))?;
-            if ty.is_dir() && depth < super::MAX_DEPTH {
+            if ty.is_dir() && depth < super::MAX_DEPTH && !guard::another_root(&path) {
                 folders.push((path, depth + 1));
             } else if ty.is_file() && entry.file_name().to_string_lossy().starts_with(TMP_PREFIX) {
                 found.push(path);

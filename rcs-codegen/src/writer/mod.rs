@@ -183,7 +183,7 @@ fn write(
     let _lock = OutputLock::acquire(out_dir, blocked)?;
     let root = std::fs::canonicalize(out_dir).map_err(|e| io_err(out_dir, e))?;
     let mut report = WriteReport {
-        recovered: journal::recover(out_dir)?,
+        recovered: journal::recover(&root, out_dir)?,
         swept: journal::sweep_temporaries(out_dir)?,
         ..WriteReport::default()
     };

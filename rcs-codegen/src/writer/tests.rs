@@ -352,3 +352,51 @@ fn a_second_writer_waits_for_the_lock() {
     assert_eq!(report.written, vec![dir.join("x.md")]);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn recovery_checks_again_what_changed_since_the_crash() {
+    let dir = scratch("recheck");
+    write_tree(
+        &dir,
+        &[file("a.md", "old"), file("b.md", "old")],
+        &mut quiet,
+    )
+    .unwrap();
+    CRASH_AFTER.set(Some(0));
+    assert!(write_tree(
+        &dir,
+        &[file("a.md", "new"), file("b.md", "new")],
+        &mut quiet
+    )
+    .is_err());
+    CRASH_AFTER.set(None);
+    // Meanwhile someone writes b.md by hand.
+    std::fs::write(dir.join("b.md"), "mine\n").unwrap();
+    let r = write_files(&dir, &[file("c.md", "")], &mut quiet).unwrap();
+    assert!(r.recovered);
+    assert_eq!(r.swept.len(), 1, "b.md's temporary, not renamed");
+    assert!(tree(&dir)["a.md"].ends_with("new"));
+    assert_eq!(tree(&dir)["b.md"], "mine\n", "the hand-written file kept");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_folder_another_build_is_writing_is_left_to_it() {
+    let dir = scratch("nested");
+    write_tree(&dir, &[file("a.md", "")], &mut quiet).unwrap();
+    let inner = dir.join("inner");
+    std::fs::create_dir_all(&inner).unwrap();
+    let held = OutputLock::acquire(&inner, &mut quiet).unwrap();
+    std::fs::write(inner.join(".rcsc-tmp-1-0"), "").unwrap();
+    std::fs::write(inner.join("x.md"), format!("{GENERATED}\n")).unwrap();
+    let r = write_tree(&dir, &[file("a.md", "")], &mut quiet).unwrap();
+    assert!(r.swept.is_empty() && r.removed.is_empty(), "{r:?}");
+    drop(held);
+    // On Unix the lock file goes with the lock; elsewhere it stays, and
+    // the folder stays another build's.
+    if cfg!(unix) {
+        let r = write_tree(&dir, &[file("a.md", "")], &mut quiet).unwrap();
+        assert_eq!((r.swept.len(), r.removed.len()), (1, 1), "{r:?}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -202,14 +202,9 @@ fn concurrent_builds_into_one_folder_take_turns() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-#[test]
-fn a_waiting_build_says_so() {
-    let dir = scratch("blocking", &[]);
-    let set = plan_set(&dir.join("plans"), 2, 0);
-    let out = dir.join("out");
-    std::fs::create_dir_all(&out).unwrap();
-    let held = rcs_codegen::writer::OutputLock::acquire(&out, &mut |_| {}).unwrap();
-    let mut child = spawn_build(&set, &out, Stdio::piped());
+/// Read `child`'s stderr until a line contains `needle` (bounded); that
+/// line, and the thread still reading the rest.
+fn wait_for_line(child: &mut Child, needle: &str) -> (String, std::thread::JoinHandle<()>) {
     let stderr = BufReader::new(child.stderr.take().unwrap());
     let (tx, rx) = std::sync::mpsc::channel();
     let reader = std::thread::spawn(move || {
@@ -219,14 +214,25 @@ fn a_waiting_build_says_so() {
     });
     let mut seen = Vec::new();
     let deadline = Instant::now() + Duration::from_secs(120);
-    while !seen.iter().any(|l: &String| l.contains("Blocking")) {
+    loop {
         let left = deadline.saturating_duration_since(Instant::now());
         match rx.recv_timeout(left) {
+            Ok(line) if line.contains(needle) => return (line, reader),
             Ok(line) => seen.push(line),
-            Err(_) => panic!("no `Blocking` line: {seen:?}"),
+            Err(_) => panic!("no `{needle}` line: {seen:?}"),
         }
     }
-    let line = seen.last().unwrap();
+}
+
+#[test]
+fn a_waiting_build_says_so() {
+    let dir = scratch("blocking", &[]);
+    let set = plan_set(&dir.join("plans"), 2, 0);
+    let out = dir.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let held = rcs_codegen::writer::OutputLock::acquire(&out, &mut |_| {}).unwrap();
+    let mut child = spawn_build(&set, &out, Stdio::piped());
+    let (line, reader) = wait_for_line(&mut child, "Blocking");
     assert!(
         line.trim_start()
             .starts_with("Blocking waiting for file lock on "),
@@ -237,6 +243,35 @@ fn a_waiting_build_says_so() {
     assert_eq!(child.wait().unwrap().code(), Some(0));
     reader.join().unwrap();
     assert!(out.join("tables/C0.md").is_file());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `rcsc test --backend compiled` locks `<target>/rcsc` before it writes
+/// the driver crate (the run is stopped there: nothing is built).
+#[test]
+fn the_compiled_backend_locks_its_target_folder() {
+    let dir = scratch("compiled-lock", &[]);
+    let root = dir.join("rcsc");
+    std::fs::create_dir_all(&root).unwrap();
+    let held = rcs_codegen::writer::OutputLock::acquire(&root, &mut |_| {}).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rcsc"))
+        .args(["test", "plans/submarine", "--backend", "compiled"])
+        .args(["--target-dir", s(&dir)])
+        .env("NO_COLOR", "1")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("rcsc runs");
+    let (line, reader) = wait_for_line(&mut child, "Blocking");
+    assert!(line.contains("waiting for file lock on"), "{line}");
+    assert!(
+        !root.join("driver").exists(),
+        "nothing written while waiting"
+    );
+    let _ = child.kill();
+    let _ = child.wait();
+    drop(held);
+    reader.join().unwrap();
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -7,7 +7,7 @@
 //! folder (itself through a temporary and a rename, so it is whole or
 //! absent), then renames and removes, then deletes the journal. A journal
 //! found by the next write (under the lock) therefore names a build whose
-//! every new file was complete: [`recover`] rolls it forward — renames the
+//! every new file was complete: `recover` rolls it forward — renames the
 //! temporaries still there, removes the stale files still there — so the
 //! folder holds that build's complete output before anything else happens.
 //!
@@ -199,6 +199,17 @@ fn still_safe(root: &Path, out_dir: &Path, tmp: &str, target: &str) -> bool {
     tmp_ok && target_ok
 }
 
+/// A temporary's name: `.rcsc-tmp-*`, or `.<name>.rcsc-<pid>.tmp` as
+/// rcsc wrote them before this writer (pure).
+pub(super) fn is_temporary(name: &str) -> bool {
+    let legacy = name
+        .strip_prefix('.')
+        .and_then(|n| n.strip_suffix(".tmp"))
+        .and_then(|n| n.rsplit_once(".rcsc-"))
+        .is_some_and(|(_, pid)| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()));
+    name.starts_with(TMP_PREFIX) || legacy
+}
+
 /// Remove every temporary below `out_dir` (`.rcsc-tmp-*`, left by a write
 /// that was killed), not following symbolic links. Call it with the lock
 /// held: the temporaries of a live write are never there then.
@@ -217,7 +228,7 @@ pub(super) fn sweep_temporaries(out_dir: &Path) -> Result<Vec<PathBuf>, WriteErr
             let ty = entry.file_type().map_err(|e| io_err(&path, e))?;
             if ty.is_dir() && depth < super::MAX_DEPTH && !guard::another_root(&path) {
                 folders.push((path, depth + 1));
-            } else if ty.is_file() && entry.file_name().to_string_lossy().starts_with(TMP_PREFIX) {
+            } else if ty.is_file() && is_temporary(&entry.file_name().to_string_lossy()) {
                 found.push(path);
             }
         }
@@ -243,6 +254,26 @@ mod tests {
             Step::Remove("tables/B.md".into()),
         ];
         assert_eq!(parse(&render(&steps)), Some(steps));
+    }
+
+    #[test]
+    fn temporaries_are_recognised_by_name() {
+        for yes in [
+            ".rcsc-tmp-12-0",
+            ".rcsc-tmp-1-journal",
+            ".PR.md.rcsc-4242.tmp",
+        ] {
+            assert!(is_temporary(yes), "{yes}");
+        }
+        for no in [
+            "PR.md",
+            ".rcsc-lock",
+            ".rcsc-journal",
+            ".x.rcsc-.tmp",
+            "x.rcsc-1.tmp",
+        ] {
+            assert!(!is_temporary(no), "{no}");
+        }
     }
 
     #[test]

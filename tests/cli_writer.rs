@@ -130,6 +130,45 @@ fn a_linked_folder_leading_out_is_refused() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A folder no file can be created in, for as long as this lives: by its
+/// permissions, or (for root, whom they do not stop) by `chattr +i` where
+/// that works. `None` where neither does.
+struct Unwritable(PathBuf);
+
+impl Unwritable {
+    fn make(dir: &Path) -> Option<Unwritable> {
+        let guard = Unwritable(dir.to_path_buf());
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let read_only = std::fs::Permissions::from_mode(0o555);
+            std::fs::set_permissions(dir, read_only).ok()?;
+        }
+        if guard.writable() {
+            let _ = Command::new("chattr").arg("+i").arg(dir).output();
+        }
+        (!guard.writable()).then_some(guard)
+    }
+
+    fn writable(&self) -> bool {
+        let probe = self.0.join("probe");
+        let ok = std::fs::write(&probe, "").is_ok();
+        let _ = std::fs::remove_file(probe);
+        ok
+    }
+}
+
+impl Drop for Unwritable {
+    fn drop(&mut self) {
+        let _ = Command::new("chattr").arg("-i").arg(&self.0).output();
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let _ = std::fs::set_permissions(&self.0, std::fs::Permissions::from_mode(0o755));
+        }
+    }
+}
+
 #[test]
 fn an_error_part_way_leaves_the_old_outputs_whole() {
     let dir = scratch("io", &[]);
@@ -146,23 +185,16 @@ fn an_error_part_way_leaves_the_old_outputs_whole() {
     assert!(tree(&out) == before, "the old outputs, byte for byte");
     assert!(split(&out).1.is_empty(), "no temporaries");
 
-    // A folder the build may not write into (unless running as root,
-    // whom permissions do not stop).
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        std::fs::remove_dir_all(out.join("tables/C4.md")).unwrap();
-        let locked = out.join("graphs/C3");
-        std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o555)).unwrap();
-        let root = std::fs::write(locked.join("probe"), "").is_ok();
-        let _ = std::fs::remove_file(locked.join("probe"));
-        if !root {
-            let before = tree(&out);
-            let (code, err) = build(&new, &out);
-            assert_eq!(code, Some(2), "{err}");
-            assert!(tree(&out) == before, "the old outputs, byte for byte");
-        }
-        std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o755)).unwrap();
+    // A folder the build cannot write into, late in its order: staging
+    // fails part-way, after other temporaries were written.
+    std::fs::remove_dir_all(out.join("tables/C4.md")).unwrap();
+    if let Some(_unwritable) = Unwritable::make(&out.join("graphs/C3")) {
+        let before = tree(&out);
+        let (code, err) = build(&new, &out);
+        assert_eq!(code, Some(2), "{err}");
+        assert!(err.contains("graphs/C3"), "{err}");
+        assert!(tree(&out) == before, "the old outputs, byte for byte");
+        assert!(split(&out).1.is_empty(), "no temporaries");
     }
     let (code, err) = build(&new, &out);
     assert_eq!(code, Some(0), "{err}");

@@ -217,7 +217,8 @@ fn a_build_killed_while_renaming_is_finished_by_the_next() {
         assert_eq!(t.keys().collect::<Vec<_>>(), ["a.md", "b/c.md", "e.md"]);
         assert!(t.values().all(|v| v.ends_with("new")), "{t:?}");
     };
-    for k in 0..4 {
+    // Killed before the first step, between any two, or after the last.
+    for k in 0..=4 {
         let dir = scratch(&format!("killed-{k}"));
         write_tree(&dir, &old, &mut quiet).unwrap();
         CRASH_AFTER.set(Some(k));

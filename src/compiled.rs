@@ -14,6 +14,7 @@
 //! with, so after the first build a run costs a second or two and needs no
 //! network.
 
+use rcs_codegen::writer::OutputLock;
 use rcs_dsl::ir::Ir;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
@@ -31,6 +32,9 @@ pub struct Driver {
     child: Child,
     /// `Some` between controllers; a `Remote` borrows the pipes while open.
     pipes: Option<(BufReader<ChildStdout>, ChildStdin)>,
+    /// The lock on `<target>/rcsc`, held while the driver runs, so that
+    /// another run's plan sets cannot rebuild it under this one.
+    _lock: OutputLock,
 }
 
 /// A controller of the driver process, for one scenario.
@@ -110,7 +114,7 @@ fn runtime_dependency(root: &Path) -> Result<String, String> {
         let path = local.display().to_string().replace('\\', "/");
         return Ok(format!("{{ path = {path:?} }}"));
     }
-    rcs_codegen::writer::write_tree(&root.join(RUNTIME_DIR), &runtime_files())
+    rcs_codegen::writer::write_tree(&root.join(RUNTIME_DIR), &runtime_files(), &mut |_| {})
         .map_err(|e| format!("writing the runtime crate: {e}"))?;
     Ok(format!("{{ path = \"../{RUNTIME_DIR}\" }}"))
 }
@@ -161,15 +165,26 @@ fn crate_files(irs: &[&Ir], runtime: &str) -> Vec<rcs_codegen::OutputFile> {
 }
 
 /// Write, build and start the driver for these plan sets. `status` prints
-/// a progress line.
-pub fn build(irs: &[&Ir], target_dir: &Path, status: &dyn Fn(&str)) -> Result<Driver, String> {
+/// a progress line; `blocked` is called before waiting for another run's
+/// lock on `<target>/rcsc` (held from the first write until the driver
+/// ends, so concurrent runs take turns as cargo's builds do).
+pub fn build(
+    irs: &[&Ir],
+    target_dir: &Path,
+    status: &dyn Fn(&str),
+    blocked: &mut dyn FnMut(&Path),
+) -> Result<Driver, String> {
     let root = target_dir.join("rcsc");
+    std::fs::create_dir_all(&root)
+        .map_err(|e| format!("cannot create {}: {e}", rcs_dsl::load::display(&root)))?;
+    let held = OutputLock::acquire(&root, blocked)
+        .map_err(|e| format!("locking the scenario driver's folder: {e}"))?;
     let source = root.join("driver");
     let build_dir = root.join("driver-target");
     let runtime = runtime_dependency(&root)?;
     let mut files = crate_files(irs, &runtime);
     rcs_codegen::rustfmt::format_files(&mut files);
-    let report = rcs_codegen::writer::write_tree(&source, &files)
+    let report = rcs_codegen::writer::write_tree(&source, &files, &mut |_| {})
         .map_err(|e| format!("writing the scenario driver: {e}"))?;
     let lock = source.join("Cargo.lock");
     if !lock.exists() {
@@ -231,6 +246,7 @@ pub fn build(irs: &[&Ir], target_dir: &Path, status: &dyn Fn(&str)) -> Result<Dr
     Ok(Driver {
         child,
         pipes: Some((BufReader::new(stdout), stdin)),
+        _lock: held,
     })
 }
 

@@ -28,8 +28,9 @@ impl Witnesses {
                 w.state
             ));
             let about = format!(
-                "Written by `rcsc check --witnesses`: reproduces the {} finding\n{}\n\
+                "{} (`rcsc check --witnesses`): reproduces the {} finding\n{}\n\
                  Run it with `rcsc test PLANS THIS_FILE`.",
+                rcs_codegen::GENERATED,
                 d.code.name(),
                 d.message
             );
@@ -76,9 +77,7 @@ impl Witnesses {
                 contents: contents.clone(),
             })
             .collect();
-        std::fs::create_dir_all(dir)
-            .map_err(|e| format!("cannot write {}: {e}", rcs_dsl::load::display(dir)))?;
-        rcs_codegen::writer::write_files(dir, &files)
+        rcs_codegen::writer::write_files(dir, &files, &mut |_| {})
             .map(|_| ())
             .map_err(|e| format!("cannot write witnesses: {e}"))
     }

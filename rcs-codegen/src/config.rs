@@ -15,7 +15,8 @@
 //! `rcs.yaml`, exactly as `rcsc build` does), checks every set and, when
 //! none has an error, writes every output of [`crate::generate`] through
 //! [`crate::writer::write_tree`] (so outputs it no longer produces are
-//! removed): one plan set into `$OUT_DIR/rcs/`, a workspace's sets into
+//! removed, under the output folder's lock, with every promise of the
+//! writer): one plan set into `$OUT_DIR/rcs/`, a workspace's sets into
 //! `$OUT_DIR/rcs/<system>/`, plus `include.rs`, which maps each compiled
 //! set's name to its file for `include_plans!` (and any other name to a
 //! compile error that lists them). It talks to cargo on stdout:
@@ -246,7 +247,16 @@ impl Config {
             None => PathBuf::from(env("OUT_DIR", "out_dir")?).join("rcs"),
         };
         let files = produced_so_far(&out_dir, &path, files)?;
-        Ok(writer::write_tree(&out_dir, &files)?)
+        // The same lock as `rcsc build`'s: a build script and a CLI build
+        // into one folder take turns.
+        let mut blocked = |dir: &Path| {
+            let _ = writeln!(
+                diagnostics,
+                "    Blocking waiting for file lock on {}",
+                dir.display()
+            );
+        };
+        Ok(writer::write_tree(&out_dir, &files, &mut blocked)?)
     }
 
     /// `path` against the manifest directory. When that is the current

@@ -10,7 +10,10 @@
 //! ```
 //!
 //! Between generation and the writer, [`rustfmt`] formats the Rust files
-//! with the installed `rustfmt` (when there is one).
+//! with the installed `rustfmt` (when there is one). The [`writer`] locks
+//! the output folder, stages every file and commits them through a
+//! journal, and never writes through a link leading out of the folder or
+//! over a file rcsc did not generate (see its docs for what it promises).
 
 pub mod config;
 pub mod dot;

@@ -52,12 +52,13 @@ pub enum Code {
     Manifest,
     LooseFile,
     TooLarge,
+    CaseCollision,
     Lint(Lint),
 }
 
 impl Code {
     /// Every hard-error code, in catalogue order (lints follow in [`Lint::ALL`]).
-    pub const ERRORS: [Code; 22] = [
+    pub const ERRORS: [Code; 23] = [
         Code::Syntax,
         Code::DuplicateDefinition,
         Code::UnknownName,
@@ -80,6 +81,7 @@ impl Code {
         Code::Manifest,
         Code::LooseFile,
         Code::TooLarge,
+        Code::CaseCollision,
     ];
 
     pub fn name(self) -> &'static str {
@@ -106,6 +108,7 @@ impl Code {
             Code::Manifest => "manifest",
             Code::LooseFile => "loose_file",
             Code::TooLarge => "too_large",
+            Code::CaseCollision => "case_collision",
             Code::Lint(l) => l.name(),
         }
     }
@@ -136,6 +139,9 @@ impl Code {
             Code::LooseFile => "a `.rcs` file stands beside plan-set folders",
             Code::TooLarge => {
                 "a plan or controller has more of something than the runtime can number"
+            }
+            Code::CaseCollision => {
+                "two names differ only in case where they become one output file name"
             }
             Code::Lint(Lint::RuleOfTen) => "a plan has more rows than the rule of ten allows",
             Code::Lint(Lint::ShadowedRow) => "earlier rows always match before this row",

@@ -177,7 +177,7 @@ fn finish(ir: Option<ir::Ir>, diags: Diagnostics) -> Checked {
 }
 
 /// A folder name as a Rust-friendly system name.
-fn sanitize(name: &str) -> String {
+pub(crate) fn sanitize(name: &str) -> String {
     let mut s: String = name
         .chars()
         .map(|c| {

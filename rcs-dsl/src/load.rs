@@ -189,7 +189,56 @@ pub fn load_paths(paths: &[PathBuf]) -> Result<Vec<PlanSet>, LoadError> {
         }
         sets.push(set);
     }
+    if shares_output(&sets) {
+        report_case_collisions(&mut sets);
+    }
     Ok(sets)
+}
+
+/// The system name a plan set will have (its folder is `<system>/` in a
+/// shared output folder).
+fn system_name(set: &PlanSet) -> (String, Option<Span>) {
+    match &set.manifest.system {
+        Some((name, span)) => (name.clone(), Some(*span)),
+        None => (crate::sanitize(&set.name), None),
+    }
+}
+
+/// `case_collision` for plan sets sharing an output folder whose system
+/// names differ only in case (`Sub/` and `sub/` are one folder on a
+/// case-insensitive file system), reported at the `system:` that named one
+/// (equal names are refused when the outputs are generated).
+fn report_case_collisions(sets: &mut [PlanSet]) {
+    let names: Vec<(String, Option<Span>)> = sets.iter().map(system_name).collect();
+    let indexed = names
+        .iter()
+        .enumerate()
+        .map(|(i, (name, _))| (name.as_str(), i));
+    for ((_, ai), (_, bi)) in crate::checks::names::case_pairs(indexed) {
+        // Report at whichever `system:` is written (at least one is: folder
+        // names are lowercased).
+        let (here, other) = match (names[bi].1, names[ai].1) {
+            (Some(span), _) => ((bi, span), ai),
+            (None, Some(span)) => ((ai, span), bi),
+            (None, None) => continue,
+        };
+        let (this, that) = (&names[here.0].0, &names[other].0);
+        let other_root = sets[other].root.clone();
+        sets[here.0].diagnostics.push(
+            Diagnostic::error(
+                Code::CaseCollision,
+                format!("plan sets `{this}` and `{that}` differ only in case"),
+                here.1,
+                format!("`{that}` but for case"),
+            )
+            .with_note(format!(
+                "`{that}` is the plan set at `{other_root}`; their outputs go to `{this}/` and \
+                 `{that}/` of one output folder, which case-insensitive file systems (macOS \
+                 and Windows by default) see as one folder"
+            ))
+            .with_help("rename one (`system:` in its rcs.yaml)"),
+        );
+    }
 }
 
 /// Load exactly one plan-set folder: its `.rcs` files (honouring its

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// Run `rcsc` in `cwd`, without colour.
+#[allow(dead_code)] // each test binary compiles this module; not all use it
 pub fn rcsc_in(cwd: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_rcsc"))
         .args(args)
@@ -16,6 +17,7 @@ pub fn rcsc_in(cwd: &Path, args: &[&str]) -> Output {
 }
 
 /// Run `rcsc` in the repository root (cargo's working folder for tests).
+#[allow(dead_code)] // each test binary compiles this module; not all use it
 pub fn rcsc(args: &[&str]) -> Output {
     rcsc_in(Path::new("."), args)
 }

@@ -9,6 +9,7 @@ mod hang;
 mod hierarchy;
 mod limits;
 mod loops;
+pub(crate) mod names;
 mod plan;
 mod usage;
 
@@ -93,6 +94,7 @@ pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagno
         return;
     }
     plan::check_missing_plans(ir, &mut sink);
+    names::check_case_collisions(ir, &mut sink);
     // The analysis of every plan's conditions and its graph first: the
     // checks of a plan ask its own, the handshake checks their
     // subordinates'.

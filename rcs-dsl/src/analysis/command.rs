@@ -163,11 +163,20 @@ impl PlanAnalysis<'_> {
     /// `S0` "any cycle" includes the first, so a row back to `S0`, whose
     /// entry rows need a new command, is still reported.
     pub fn hangs(&self) -> Vec<Hang> {
+        let constants = self.constant_vars();
+        let n = self.plan.states.len();
+        // The usual plan has, in each state, a row that does not depend on
+        // the command's values at all (a timeout, an emergency stop, a wait
+        // on an input) and that can match: it can whatever those values
+        // are, so no state can hang, and the walks need not be taken.
+        let mut fixed: Vec<LeafId> = self.command_leaves();
+        fixed.extend(constants.iter().map(|(l, _)| *l));
+        if (0..n).all(|s| self.may_match_whatever(StateId(s as u32), &fixed)) {
+            return Vec::new();
+        }
         let Some(cases) = self.command_cases() else {
             return Vec::new();
         };
-        let constants = self.constant_vars();
-        let n = self.plan.states.len();
         let mut found: Vec<Option<Hang>> = vec![None; n + 1];
         // Per state: no row covering it can match whatever the command.
         let mut dead: Vec<Option<bool>> = vec![None; n];
@@ -214,7 +223,14 @@ impl PlanAnalysis<'_> {
     /// condition but not with any case the state may be reached with.
     /// Only the command's parameters are pinned (every answer a proof).
     pub fn entry_bound_rows(&self) -> Vec<EntryBound> {
-        if self.command_leaves().is_empty() {
+        let params = self.command_leaves();
+        // Only a row that compares a parameter exactly can be made false
+        // by the values its state is entered with (for a proof, an opaque
+        // atom is a free boolean whatever the parameter).
+        let candidates = self.plan.rows.iter().enumerate().any(|(i, row)| {
+            matches!(row.from, From::State(s) if s != StateId::S0) && !self.free_of(i, &params)
+        });
+        if params.is_empty() || !candidates {
             return Vec::new();
         }
         let Some(cases) = self.command_cases() else {
@@ -258,6 +274,38 @@ impl PlanAnalysis<'_> {
             });
         }
         out
+    }
+
+    /// Whether no exact atom of row `row`'s condition reads one of
+    /// `leaves` (pinning them then changes nothing a proof sees).
+    fn free_of(&self, row: usize, leaves: &[LeafId]) -> bool {
+        let Some(cond) = &self.conds[row] else {
+            return true;
+        };
+        let mut free = true;
+        cond.visit_atoms(&mut |a| {
+            let atom = &self.terms.atoms[a];
+            free &= !(atom.exact && atom.leaves.iter().any(|l| leaves.contains(l)));
+        });
+        free
+    }
+
+    /// Whether, on any cycle after the command's first, some row covering
+    /// `state` may match whatever values `fixed` hold: an `otherwise` row,
+    /// or a row free of them that the proof cannot rule out.
+    fn may_match_whatever(&self, state: StateId, fixed: &[LeafId]) -> bool {
+        let later = [(self.new_command, Value::Bool(false))];
+        self.plan.rows.iter().enumerate().any(|(i, row)| {
+            covers(&row.from, state)
+                && self.free_of(i, fixed)
+                && match &self.conds[i] {
+                    None => true,
+                    Some(c) => {
+                        let f = Formula::Shared(c.clone());
+                        !matches!(self.prove(&f, &later), Outcome::None)
+                    }
+                }
+        })
     }
 
     /// The leaves pinned on node `node`'s cycles: `given`, and

@@ -567,6 +567,24 @@ impl<'ir> Driven<'ir> {
             .ok_or_else(|| rcs_runtime::driver::unknown(&c.name, "subordinate", sub))
     }
 
+    /// Buffer `name` of `list` (the controller's `reads` or `writes`):
+    /// its index and `value` typed as it.
+    fn buffer_value(
+        &self,
+        list: &[BufferId],
+        kind: &str,
+        name: &str,
+        value: &Value,
+    ) -> Result<(usize, Value), rcs_runtime::driver::DriveError> {
+        let c = self.interp.controller();
+        let i = list
+            .iter()
+            .position(|b| self.ir.buffers[b.index()].name == name)
+            .ok_or_else(|| rcs_runtime::driver::unknown(&c.name, kind, name))?;
+        let ty = Type::Buffer(self.ir.buffers[list[i].index()].ty);
+        Ok((i, self.typed(&ty, name, value)?))
+    }
+
     fn typed(
         &self,
         t: &Type,
@@ -613,13 +631,7 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
         value: &Value,
     ) -> Result<(), rcs_runtime::driver::DriveError> {
         let c = self.interp.controller();
-        let i = c
-            .reads
-            .iter()
-            .position(|b| self.ir.buffers[b.index()].name == buffer)
-            .ok_or_else(|| rcs_runtime::driver::unknown(&c.name, "read buffer", buffer))?;
-        let ty = Type::Buffer(self.ir.buffers[c.reads[i].index()].ty);
-        let v = self.typed(&ty, buffer, value)?;
+        let (i, v) = self.buffer_value(&c.reads, "read buffer", buffer, value)?;
         self.interp.set_read(i, v);
         Ok(())
     }
@@ -637,6 +649,29 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
             .ok_or_else(|| rcs_runtime::driver::unknown(&c.name, "hook", hook))?;
         let v = self.typed(&c.hooks[i].ret, hook, value)?;
         self.hooks.values[i] = Some(v);
+        Ok(())
+    }
+
+    fn set_var(&mut self, var: &str, value: &Value) -> Result<(), rcs_runtime::driver::DriveError> {
+        let c = self.interp.controller();
+        let i = c
+            .vars
+            .iter()
+            .position(|v| v.name == var)
+            .ok_or_else(|| rcs_runtime::driver::unknown(&c.name, "var", var))?;
+        let v = self.typed(&c.vars[i].ty, var, value)?;
+        self.interp.vars[i] = v;
+        Ok(())
+    }
+
+    fn set_write(
+        &mut self,
+        buffer: &str,
+        value: &Value,
+    ) -> Result<(), rcs_runtime::driver::DriveError> {
+        let c = self.interp.controller();
+        let (i, v) = self.buffer_value(&c.writes, "write buffer", buffer, value)?;
+        self.interp.writes[i] = v;
         Ok(())
     }
 

@@ -181,10 +181,12 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
         read_names,
         read_handles,
         write_fields,
+        write_names,
         sub_names,
         sub_modules,
         ..
     } = Wiring::new(ir, names, ci);
+    let var_names: Vec<&str> = c.vars.iter().map(|v| v.name.as_str()).collect();
     let var_fields = &n.vars;
     let sub_cmd: Vec<_> = n.subs.iter().map(|f| prefixed("cmd", f)).collect();
     let sub_status: Vec<_> = n.subs.iter().map(|f| prefixed("status", f)).collect();
@@ -254,6 +256,30 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
         )
     };
 
+    let (var_param, var_match) = if c.vars.is_empty() {
+        (quote!(_), quote!())
+    } else {
+        (
+            quote!(value),
+            quote!(#(#var_names => {
+                self.controller.data.vars.#var_fields = #dv::typed(NAME, var, value)?;
+                Ok(())
+            })*),
+        )
+    };
+    let (write_param, write_match) = if c.writes.is_empty() {
+        (quote!(_), quote!())
+    } else {
+        (
+            quote!(value),
+            quote!(#(#write_names => {
+                self.controller.data.writes.#write_fields = #dv::typed(NAME, buffer, value)?;
+                Ok(())
+            })*),
+        )
+    };
+    let var_match_body = by_name("var", "var", var_match);
+    let write_match_body = by_name("buffer", "write buffer", write_match);
     let read_match_body = by_name("buffer", "read buffer", read_match);
     let hook_match_body = by_name("hook", "hook", hook_match);
     let sub_match_body = by_name("sub", "subordinate", sub_match);
@@ -312,6 +338,14 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
 
             fn set_hook(&mut self, hook: &str, #hook_param: &#dv::Value) -> Result<(), #dv::DriveError> {
                 #hook_match_body
+            }
+
+            fn set_var(&mut self, var: &str, #var_param: &#dv::Value) -> Result<(), #dv::DriveError> {
+                #var_match_body
+            }
+
+            fn set_write(&mut self, buffer: &str, #write_param: &#dv::Value) -> Result<(), #dv::DriveError> {
+                #write_match_body
             }
 
             fn write_sub_status(&mut self, sub: &str, #subs_param: rt::StatusBuffer) -> Result<(), #dv::DriveError> {

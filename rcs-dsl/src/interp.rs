@@ -531,11 +531,14 @@ struct Scripted<'ir> {
     values: Vec<Option<Value>>,
     /// Calls of each hook since the last cycle's record.
     calls: Vec<u32>,
+    /// Those calls' arguments, in order.
+    args: Vec<(u16, Vec<Value>)>,
 }
 
 impl Hooks for Scripted<'_> {
-    fn call(&mut self, data: &HookData, hook: HookId, _: &[Value]) -> Value {
+    fn call(&mut self, data: &HookData, hook: HookId, args: &[Value]) -> Value {
         self.calls[hook.index()] = self.calls[hook.index()].saturating_add(1);
+        self.args.push((hook.0 as u16, args.to_vec()));
         self.values[hook.index()]
             .clone()
             .unwrap_or_else(|| zero(self.ir, &data.ctrl.hooks[hook.index()].ret))
@@ -550,6 +553,7 @@ impl<'ir> Driven<'ir> {
             ir,
             values: vec![None; interp.controller().hooks.len()],
             calls: vec![0; interp.controller().hooks.len()],
+            args: Vec::new(),
         };
         Driven { ir, interp, hooks }
     }
@@ -693,6 +697,7 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
         let rec = self.interp.cycle(&mut self.hooks);
         let hook_calls = self.hooks.calls.clone();
         self.hooks.calls.fill(0);
+        let hook_args = std::mem::take(&mut self.hooks.args);
         let c = self.interp.controller();
         rcs_runtime::driver::Record {
             cycle: rec.cycle,
@@ -714,6 +719,7 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
             vars: rec.vars,
             writes: rec.writes,
             hook_calls,
+            hook_args,
         }
     }
 }

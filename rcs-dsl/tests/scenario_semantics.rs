@@ -363,3 +363,30 @@ fn hooks_called_counts_a_steps_calls() {
         "hooks_called.probe: expected 2 call(s) in the step, got 1"
     );
 }
+
+#[test]
+fn hooks_called_checks_each_calls_arguments() {
+    let ir = ir();
+    passes(
+        &ir,
+        "controller: A\ninitial: { vars: { n: 3 } }\nsteps:\n  - command: ON\n  - cycles: 2\n    expect: { hooks_called: { probe: [{ k: 3 }, { k: 3 }], answer: [{}, {}] } }\n",
+    );
+    let f = failure(
+        &ir,
+        "controller: A\nsteps:\n  - command: ON\n  - cycles: 3\n    expect: { hooks_called: { probe: [{ k: 1 }] } }\n",
+    );
+    assert_eq!(
+        f,
+        "hooks_called.probe: expected [(k: 1)], got [(k: 0), (k: 0), … (3 calls)]"
+    );
+    let (line, message) = parse(
+        &ir,
+        "controller: A\nsteps:\n  - expect: { hooks_called: { probe: [{ j: 1 }] } }\n",
+    )
+    .err()
+    .expect("refused");
+    assert_eq!(
+        (line, message.as_str()),
+        (3, "hook `probe` has no parameter `j`")
+    );
+}

@@ -297,6 +297,11 @@ pub struct Record {
     /// order (a condition's call counts once however many rows ask).
     #[serde(default)]
     pub hook_calls: Vec<u32>,
+    /// Each hook call this cycle that ran (not one answered from the
+    /// cycle's condition cache): the hook's index and its arguments, in
+    /// call order.
+    #[serde(default)]
+    pub hook_args: Vec<(u16, Vec<Value>)>,
 }
 
 /// One controller driven alone. Names are as written in the plans.

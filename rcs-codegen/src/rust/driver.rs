@@ -138,37 +138,47 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
     let hook_fns = c.hooks.iter().enumerate().map(|(hi, h)| {
         let id = &n.hooks[hi];
         let tys = h.params.iter().map(|p| rust_type(names, &p.ty));
-        let blanks = h.params.iter().map(|_| quote!(_));
+        let args: Vec<_> = (0..h.params.len())
+            .map(|k| format_ident!("a{}", k))
+            .collect();
         let i = proc_macro2::Literal::usize_unsuffixed(hi);
-        let count = quote!(self.call_counts[#i] = self.call_counts[#i].saturating_add(1););
+        let i16 = proc_macro2::Literal::u16_suffixed(hi as u16);
+        let count = quote! {
+            self.call_counts[#i] = self.call_counts[#i].saturating_add(1);
+            self.call_args.push((#i16, vec![#(#dv::ToValue::to_value(&#args)),*]));
+        };
         if h.ret == Type::Unit {
-            quote!(fn #id(&mut self, _: &Data #(, #blanks: #tys)*) { #count })
+            quote!(fn #id(&mut self, _: &Data #(, #args: #tys)*) { #count })
         } else {
             let ret = rust_type(names, &h.ret);
-            quote!(fn #id(&mut self, _: &Data #(, #blanks: #tys)*) -> #ret { #count self.#id })
+            quote!(fn #id(&mut self, _: &Data #(, #args: #tys)*) -> #ret { #count self.#id })
         }
     });
     let hook_count = proc_macro2::Literal::usize_unsuffixed(c.hooks.len());
     let hooks_default = if c.hooks.iter().all(|h| derivable_default(&h.ret)) {
         quote! {
-            #[derive(Clone, Copy, Debug, Default, PartialEq)]
+            #[derive(Clone, Debug, Default, PartialEq)]
             pub struct ScriptedHooks {
                 #(pub #hook_fields: #hook_tys,)*
                 /// Calls of each hook since the last cycle's record.
                 pub call_counts: [u32; #hook_count],
+                /// Those calls' hook indices and arguments, in order.
+                pub call_args: Vec<(u16, Vec<#dv::Value>)>,
             }
         }
     } else {
         let zeros = c.hooks.iter().map(|h| zero(names, &h.ret));
         quote! {
-            #[derive(Clone, Copy, Debug, PartialEq)]
+            #[derive(Clone, Debug, PartialEq)]
             pub struct ScriptedHooks {
                 #(pub #hook_fields: #hook_tys,)*
                 /// Calls of each hook since the last cycle's record.
                 pub call_counts: [u32; #hook_count],
+                /// Those calls' hook indices and arguments, in order.
+                pub call_args: Vec<(u16, Vec<#dv::Value>)>,
             }
             impl Default for ScriptedHooks {
-                fn default() -> Self { Self { #(#hook_fields: #zeros,)* call_counts: [0; #hook_count] } }
+                fn default() -> Self { Self { #(#hook_fields: #zeros,)* call_counts: [0; #hook_count], call_args: Vec::new() } }
             }
         }
     };
@@ -367,6 +377,7 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
                 self.cycle += 1;
                 let hook_calls = self.controller.hooks().call_counts.to_vec();
                 self.controller.hooks_mut().call_counts = [0; #hook_count];
+                let hook_args = ::std::mem::take(&mut self.controller.hooks_mut().call_args);
                 let bk = self.controller.bookkeeping();
                 #bind_data
                 #dv::Record {
@@ -380,6 +391,7 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
                     vars: vec![#(#dv::ToValue::to_value(&data.vars.#var_fields)),*],
                     writes: vec![#(#dv::ToValue::to_value(&data.writes.#write_fields)),*],
                     hook_calls,
+                    hook_args,
                 }
             }
         }

@@ -72,7 +72,17 @@ struct Expect {
     /// Subset match: only the fields named are compared.
     writes: Vec<(usize, Json)>,
     /// Calls of each hook named, over all the step's cycles.
-    hooks_called: Vec<(HookId, u64)>,
+    hooks_called: Vec<(HookId, Called)>,
+}
+
+/// What `hooks_called` expects of one hook over a step.
+#[derive(Clone, Debug)]
+enum Called {
+    /// This many calls.
+    Times(u64),
+    /// These calls, in order: each call's arguments by parameter position
+    /// (`None`: a parameter the expectation leaves out).
+    With(Vec<Vec<Option<Value>>>),
 }
 
 struct Step {

@@ -7,7 +7,7 @@
 
 use super::report::{row_aliases, row_name};
 use super::values::{merge, value, verb_call};
-use super::{err, Echo, Expect, Scenario, ScenarioError, Step, SubSetting, MAX_CYCLES};
+use super::{err, Called, Echo, Expect, Scenario, ScenarioError, Step, SubSetting, MAX_CYCLES};
 use crate::interp::{zero, Value};
 use crate::ir::*;
 use crate::source::SourceFile;
@@ -277,6 +277,44 @@ impl Resolver<'_> {
         Ok(out)
     }
 
+    /// `hooks_called.NAME`: a count, or a list of calls, each a mapping of
+    /// parameter names to the arguments expected.
+    fn called(&self, line: usize, hook: &Hook, v: &Json) -> Result<Called, ScenarioError> {
+        let shape = || {
+            err(
+                line,
+                format!(
+                    "`hooks_called.{}` is how many times the step called it (0 or more), or its calls: `[{{ param: value }}, …]`",
+                    hook.name
+                ),
+            )
+        };
+        let calls = match v {
+            Json::Number(n) => return n.as_u64().map(Called::Times).ok_or_else(shape),
+            Json::Array(calls) => calls,
+            _ => return Err(shape()),
+        };
+        let mut out = Vec::new();
+        for call in calls {
+            let Json::Object(m) = call else {
+                return Err(shape());
+            };
+            let mut args = vec![None; hook.params.len()];
+            for (k, x) in m {
+                let p = hook
+                    .params
+                    .iter()
+                    .position(|p| p.name == *k)
+                    .ok_or_else(|| {
+                        err(line, format!("hook `{}` has no parameter `{k}`", hook.name))
+                    })?;
+                args[p] = Some(value(self.ir, line, &hook.params[p].ty, x, k)?);
+            }
+            out.push(args);
+        }
+        Ok(Called::With(out))
+    }
+
     /// The rows of the controller's plans, for a hint: `AHEAD: E0–E4; INIT: E0–E1`.
     fn rows_hint(&self) -> String {
         let plans: Vec<String> = self
@@ -467,15 +505,8 @@ impl Resolver<'_> {
                 .iter()
                 .position(|h| h.name == *name)
                 .ok_or_else(|| err(line, format!("`{}` has no hook `{name}`", self.c.name)))?;
-            let n = v.as_u64().ok_or_else(|| {
-                err(
-                    line,
-                    format!(
-                        "`hooks_called.{name}` is how many times the step called it (0 or more)"
-                    ),
-                )
-            })?;
-            out.hooks_called.push((HookId(h as u32), n));
+            out.hooks_called
+                .push((HookId(h as u32), self.called(line, &self.c.hooks[h], v)?));
         }
         Ok(out)
     }

@@ -5,7 +5,7 @@
 //! `E<position>`.
 
 use super::values::{first_difference, float_eq, merge, show};
-use super::Expect;
+use super::{Called, Expect};
 use crate::interp::Value;
 use crate::ir::*;
 use rcs_runtime::driver::Record;
@@ -45,7 +45,7 @@ pub(super) fn check(
     c: &Controller,
     e: &Expect,
     rec: &Record,
-    hook_calls: &[u64],
+    hooks: StepCalls,
 ) -> Option<String> {
     let mut problems = Vec::new();
     let plan = plan_of(c, rec);
@@ -144,15 +144,72 @@ pub(super) fn check(
         }
     }
     for (h, want) in &e.hooks_called {
-        let got = hook_calls.get(h.index()).copied().unwrap_or(0);
-        if got != *want {
-            problems.push(format!(
-                "hooks_called.{}: expected {want} call(s) in the step, got {got}",
-                c.hooks[h.index()].name
-            ));
-        }
+        check_called(ir, c, *h, want, hooks, &mut problems);
     }
     (!problems.is_empty()).then(|| problems.join("; "))
+}
+
+/// The calls of all a step's cycles: a count per hook, and the arguments
+/// of the first calls of the hooks whose arguments are expected.
+pub(super) type StepCalls<'a> = (&'a [u64], &'a [(u16, Vec<Value>)]);
+
+fn check_called(
+    ir: &Ir,
+    c: &Controller,
+    h: HookId,
+    want: &Called,
+    (counts, args): StepCalls,
+    problems: &mut Vec<String>,
+) {
+    let got = counts.get(h.index()).copied().unwrap_or(0);
+    let hook = &c.hooks[h.index()];
+    let calls = match want {
+        Called::Times(n) if got != *n => {
+            return problems.push(format!(
+                "hooks_called.{}: expected {n} call(s) in the step, got {got}",
+                hook.name
+            ))
+        }
+        Called::Times(_) => return,
+        Called::With(calls) => calls,
+    };
+    let seen: Vec<&Vec<Value>> = args
+        .iter()
+        .filter(|(i, _)| usize::from(*i) == h.index())
+        .map(|(_, a)| a)
+        .collect();
+    let same = got == calls.len() as u64
+        && calls.iter().zip(&seen).all(|(w, g)| {
+            w.iter()
+                .zip(g.iter())
+                .all(|(w, g)| w.as_ref().is_none_or(|w| float_eq(w, g)))
+        });
+    if same {
+        return;
+    }
+    let call = |a: &mut dyn Iterator<Item = (&Param, Option<&Value>)>| {
+        let parts: Vec<String> = a
+            .filter_map(|(p, v)| Some(format!("{}: {}", p.name, show(ir, &p.ty, v?))))
+            .collect();
+        format!("({})", parts.join(", "))
+    };
+    let want: Vec<String> = calls
+        .iter()
+        .map(|a| call(&mut hook.params.iter().zip(a.iter().map(Option::as_ref))))
+        .collect();
+    let mut got_calls: Vec<String> = seen
+        .iter()
+        .map(|a| call(&mut hook.params.iter().zip(a.iter().map(Some))))
+        .collect();
+    if got > seen.len() as u64 {
+        got_calls.push(format!("… ({got} calls)"));
+    }
+    problems.push(format!(
+        "hooks_called.{}: expected [{}], got [{}]",
+        hook.name,
+        want.join(", "),
+        got_calls.join(", ")
+    ));
 }
 
 type SentList = [(CtrlId, CommandId, Vec<Value>)];

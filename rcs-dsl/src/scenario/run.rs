@@ -16,7 +16,7 @@
 
 use super::report::{check, plan_of, row_name};
 use super::values::merge;
-use super::{Echo, Outcome, Scenario, SubSetting};
+use super::{Called, Echo, Outcome, Scenario, SubSetting};
 use crate::interp::{self, Value};
 use crate::ir::*;
 use rcs_runtime::driver::{DriveError, Driven, Record};
@@ -86,6 +86,7 @@ fn drive(
         })
         .collect();
     let mut hook_calls = vec![0u64; c.hooks.len()];
+    let mut hook_args: Vec<(u16, Vec<Value>)> = Vec::new();
     for (k, step) in std::iter::once(&s.initial).chain(&s.steps).enumerate() {
         let line = step.line;
         let fail = |e: DriveError| (line, e.to_string());
@@ -130,6 +131,18 @@ fn drive(
             continue; // `initial` sets the scene; it runs no cycle.
         }
         hook_calls.fill(0);
+        hook_args.clear();
+        // Arguments are kept only for hooks whose calls are expected, and
+        // only one more than expected: memory stays constant in the cycles.
+        let keep: Vec<(u16, usize)> = step
+            .expect
+            .hooks_called
+            .iter()
+            .filter_map(|(h, c)| match c {
+                Called::With(calls) => Some((h.0 as u16, calls.len() + 1)),
+                Called::Times(_) => None,
+            })
+            .collect();
         let mut last: Option<Record> = None;
         for _ in 0..step.cycles {
             for (i, sub) in subs.iter_mut().enumerate() {
@@ -150,6 +163,13 @@ fn drive(
             }
             let rec = d.cycle();
             note_fired(c, &rec, out);
+            for (h, args) in &rec.hook_args {
+                let limit = keep.iter().find(|(k, _)| k == h).map(|(_, n)| *n);
+                let kept = hook_args.iter().filter(|(k, _)| k == h).count();
+                if limit.is_some_and(|n| kept < n) {
+                    hook_args.push((*h, args.clone()));
+                }
+            }
             for (total, n) in hook_calls.iter_mut().zip(&rec.hook_calls) {
                 *total = total.saturating_add(u64::from(*n));
             }
@@ -158,7 +178,7 @@ fn drive(
         let Some(rec) = last else {
             return Err((line, "the step ran no cycle".to_string()));
         };
-        if let Some(report) = check(ir, c, &step.expect, &rec, &hook_calls) {
+        if let Some(report) = check(ir, c, &step.expect, &rec, (&hook_calls, &hook_args)) {
             return Err((line, report));
         }
     }

@@ -3,8 +3,8 @@
 //! one-cycle steps, over random scenarios), one name per row (`E<position>`),
 //! verb and variant names YAML 1.1 would read as booleans, `initial:` for
 //! vars and `writes`, values reported as the language writes them, partial
-//! arrays, the bound on `cycles` with memory constant in it, and
-//! `hooks_called`.
+//! arrays, the bound on `cycles` (memory constant in it:
+//! `scenario_memory.rs`), and `hooks_called`.
 
 use proptest::prelude::*;
 use rcs_dsl::ir::Ir;
@@ -330,21 +330,6 @@ fn cycles_run_from_one_to_the_bound_with_a_line_for_anything_else() {
         assert!(message.contains("from 1 to 10000000"), "{bad}: {message}");
     }
     assert_eq!(scenario::MAX_CYCLES, 10_000_000);
-}
-
-#[test]
-fn ten_million_cycles_keep_a_record_of_constant_length() {
-    let ir = ir();
-    let text = "controller: A\nsteps:\n  - command: ON\n  - cycles: 10000000\n    expect: { fired: none, state: S1 }\n";
-    let o = run(&ir, text);
-    assert!(o.failure.is_none(), "{:?}", o.failure);
-    assert_eq!(o.cycles(), 10_000_001);
-    // Run-length encoded: one entry for the command's row, one for the wait.
-    assert_eq!(
-        o.fired,
-        [("E1".to_string(), 1), ("-".to_string(), 10_000_000)]
-    );
-    assert_eq!(o.rows.len(), 1);
 }
 
 #[test]

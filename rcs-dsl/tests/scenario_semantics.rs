@@ -15,7 +15,7 @@ use rcs_dsl::{check, Options, PlanSet};
 /// `A` drives subordinate `B` round a loop: every DONE of B is answered
 /// with a new command, an ERROR ends the plan, a silent B is noticed.
 const PLANS: &str = r#"
-enum Answer { YES, NO, ON, OFF }
+enum Answer { YES, NO, ON, OFF, Y, N }
 buffer Out { v: i32, a: [f64; 20] }
 
 controller B {
@@ -30,6 +30,7 @@ controller A {
     command ON
     command OFF
     command BIG
+    command TRUE(flag: bool)
     var n: i32 = 0
     var d: Answer = YES
     var a: [f64; 20]
@@ -49,6 +50,7 @@ controller A {
         S1 when answer() == OFF -> Done
     }
     plan OFF { *0 when new_command -> Done }
+    plan TRUE { *0 when new_command && cmd.flag -> Done }
     plan BIG { *0 when new_command -> Done { n = 2147483647; d = ON; a[3] = 1.5 } }
 }
 "#;
@@ -243,6 +245,23 @@ fn names_yaml_1_1_reads_as_booleans_are_names() {
     );
     passes(&ir, "controller: A\ninitial: { vars: { d: NO } }\nsteps:\n  - command: OFF\n    expect: { vars: { d: NO } }\n");
     passes(&ir, "controller: A\ninitial: { vars: { d: YES } }\nsteps:\n  - command: OFF\n    expect: { vars: { d: YES } }\n");
+    for v in ["Y", "N", "OFF"] {
+        let text = format!("controller: A\ninitial: {{ vars: {{ d: {v} }} }}\nsteps:\n  - command: OFF\n    expect: {{ vars: {{ d: {v} }} }}\n");
+        passes(&ir, &text);
+    }
+    // A verb spelled like a boolean, and a boolean in any of YAML 1.2's spellings.
+    for flag in ["true", "True", "TRUE"] {
+        let text = format!("controller: A\nsteps:\n  - command: {{ TRUE: {{ flag: {flag} }} }}\n    expect: {{ status: DONE }}\n");
+        passes(&ir, &text);
+    }
+    passes(&ir, "controller: A\nsteps:\n  - command: { TRUE: { flag: FALSE } }\n    expect: { status: EXECUTING, fired: none }\n");
+    let (_, message) = parse(
+        &ir,
+        "controller: A\nsteps:\n  - command: { TRUE: { flag: yes } }\n",
+    )
+    .err()
+    .expect("refused");
+    assert!(message.contains("`flag`: expected bool"), "{message}");
 }
 
 #[test]

@@ -33,6 +33,11 @@ pub(super) fn value(
     };
     Ok(match (t, v) {
         (Type::Bool, Json::Bool(b)) => Value::Bool(*b),
+        // YAML 1.2's other spellings (the reader takes only `true`/`false`).
+        (Type::Bool, Json::String(s)) if matches!(s.as_str(), "True" | "TRUE") => Value::Bool(true),
+        (Type::Bool, Json::String(s)) if matches!(s.as_str(), "False" | "FALSE") => {
+            Value::Bool(false)
+        }
         (Type::Int(it), Json::Number(n)) => {
             let i = n
                 .as_i64()

@@ -149,9 +149,10 @@ fn drive(
                 if sub.setting.silent {
                     continue;
                 }
-                let echo = match sub.binding {
-                    Binding::Kept(e) => e,
-                    _ => echo_of(sub.setting.echo, d.last_sent(sub_name(i)).map_err(fail)?),
+                let echo = match (sub.binding, sub.setting.echo) {
+                    (Binding::Kept(e), _) | (_, Echo::Literal(e)) => e,
+                    (_, Echo::Current) => d.last_sent(sub_name(i)).map_err(fail)?,
+                    (_, Echo::Previous) => d.last_sent(sub_name(i)).map_err(fail)?.wrapping_sub(1),
                 };
                 sub.shown = echo;
                 let status = StatusBuffer {
@@ -202,13 +203,5 @@ fn note_fired(c: &Controller, rec: &Record, out: &mut Outcome) {
     if let (Some(v), Some(r)) = (rec.verb, rec.fired) {
         out.rows
             .insert((CommandId(u32::from(v)), RowId(u32::from(r))));
-    }
-}
-
-fn echo_of(e: Echo, last_sent: u32) -> u32 {
-    match e {
-        Echo::Current => last_sent,
-        Echo::Previous => last_sent.wrapping_sub(1),
-        Echo::Literal(n) => n,
     }
 }

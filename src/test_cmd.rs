@@ -204,20 +204,14 @@ pub fn load(ir: &Ir, path: &Path) -> Loaded {
 
 /// The rows fired, cycle by cycle, with runs of one name shortened
 /// (`- ×200`), so a long wait reads as one item.
-fn fired_so_far(fired: &[String]) -> String {
+fn fired_so_far(fired: &[(String, u64)]) -> String {
     let mut parts: Vec<String> = Vec::new();
-    let mut i = 0;
-    while i < fired.len() {
-        let mut j = i;
-        while j < fired.len() && fired[j] == fired[i] {
-            j += 1;
-        }
-        parts.push(if j - i > 2 {
-            format!("{} ×{}", fired[i], j - i)
+    for (name, n) in fired {
+        parts.push(if *n > 2 {
+            format!("{name} ×{n}")
         } else {
-            fired[i..j].join(", ")
+            vec![name.as_str(); *n as usize].join(", ")
         });
-        i = j;
     }
     if parts.is_empty() {
         "none (no cycle ran)".to_string()
@@ -350,9 +344,9 @@ mod tests {
 
     #[test]
     fn long_runs_of_one_row_are_shortened() {
-        let f: Vec<String> = ["E0", "-", "-", "-", "-", "E2", "E3", "E3"]
+        let f: Vec<(String, u64)> = [("E0", 1), ("-", 4), ("E2", 1), ("E3", 2)]
             .iter()
-            .map(|s| s.to_string())
+            .map(|(s, n)| (s.to_string(), *n))
             .collect();
         assert_eq!(fired_so_far(&f), "E0, - ×4, E2, E3, E3");
         assert_eq!(fired_so_far(&[]), "none (no cycle ran)");

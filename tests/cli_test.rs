@@ -117,6 +117,14 @@ fn scenario_mistakes_are_refused_with_their_line() {
                 "scenarios/bad_row.scenario.yaml",
                 "controller: A\nsteps:\n  - command: FILL\n    expect: { fired: E7 }\n",
             ),
+            (
+                "scenarios/no_cycles.scenario.yaml",
+                "controller: A\nsteps:\n  - command: FILL\n  - cycles: 0\n",
+            ),
+            (
+                "scenarios/too_many_cycles.scenario.yaml",
+                "controller: A\nsteps:\n  - command: FILL\n    cycles: 4294967295\n",
+            ),
         ],
     );
     let out = rcsc_in(&dir, &["test"]);
@@ -125,7 +133,17 @@ fn scenario_mistakes_are_refused_with_their_line() {
     for (file, line, message) in [
         ("bad_controller", 1, "unknown controller `B`"),
         ("bad_field", 4, "has no field `depth`"),
-        ("bad_row", 4, "no row of `A` is called `E7`"),
+        (
+            "bad_row",
+            4,
+            "no row of `A` is called `E7`: its rows are FILL: E0–E2",
+        ),
+        (
+            "no_cycles",
+            4,
+            "`cycles` is a whole number from 1 to 10000000, not `0`",
+        ),
+        ("too_many_cycles", 4, "from 1 to 10000000, not `4294967295`"),
     ] {
         let at = format!("scenarios/{file}.scenario.yaml:{line}: error: ");
         let hit = stdout.lines().find(|l| l.contains(&at));
@@ -134,7 +152,7 @@ fn scenario_mistakes_are_refused_with_their_line() {
             "{file}: {message}\n{stdout}"
         );
     }
-    assert_eq!(stdout.lines().last(), Some("0 passed, 3 failed"));
+    assert_eq!(stdout.lines().last(), Some("0 passed, 5 failed"));
     std::fs::remove_dir_all(dir).ok();
 }
 

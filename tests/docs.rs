@@ -12,7 +12,8 @@
 //!   `rcsc graph plans/submarine --plan PR.AHEAD --format svg` draws today
 //!   (`UPDATE_DOCS=1 cargo test --test docs` rewrites it);
 //! - the README gives the install, build and test commands, and its example
-//!   scenario passes on the submarine plans.
+//!   scenario passes on the submarine plans, as does the example of
+//!   `docs/scenarios.md`.
 
 use rcs_dsl::lint::Lint;
 use rcs_dsl::render::{self, Format};
@@ -209,15 +210,26 @@ fn the_readme_gives_install_build_and_test_commands() {
 
 #[test]
 fn the_readme_scenario_passes() {
-    let readme = std::fs::read_to_string("README.md").unwrap();
-    let scenarios: Vec<Block> = blocks(&readme)
+    doc_scenarios_pass("README.md");
+}
+
+#[test]
+fn the_scenario_reference_example_passes() {
+    doc_scenarios_pass("docs/scenarios.md");
+}
+
+/// The one scenario shown in `doc` passes on the submarine plans.
+fn doc_scenarios_pass(doc: &str) {
+    let text = std::fs::read_to_string(doc).unwrap();
+    let scenarios: Vec<Block> = blocks(&text)
         .into_iter()
         .filter(|b| b.lang == "yaml" && b.text.contains("controller:"))
         .collect();
-    assert_eq!(scenarios.len(), 1, "README.md shows one scenario");
-    let dir = std::env::temp_dir().join(format!("rcsc-docs-{}", std::process::id()));
+    assert_eq!(scenarios.len(), 1, "{doc} shows one scenario");
+    let stem = doc.replace(['/', '.'], "-");
+    let dir = std::env::temp_dir().join(format!("rcsc-docs-{stem}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("readme.scenario.yaml");
+    let file = dir.join("doc.scenario.yaml");
     std::fs::write(&file, &scenarios[0].text).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_rcsc"))
         .args(["test", "plans/submarine"])
@@ -228,7 +240,7 @@ fn the_readme_scenario_passes() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success() && stdout.ends_with("1 passed, 0 failed\n"),
-        "README.md:{}: the scenario fails:\n{stdout}",
+        "{doc}:{}: the scenario fails:\n{stdout}",
         scenarios[0].line
     );
     std::fs::remove_dir_all(dir).ok();

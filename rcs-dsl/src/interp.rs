@@ -531,11 +531,14 @@ struct Scripted<'ir> {
     values: Vec<Option<Value>>,
     /// Calls of each hook since the last cycle's record.
     calls: Vec<u32>,
+    /// Those calls' arguments, in order.
+    args: Vec<(u16, Vec<Value>)>,
 }
 
 impl Hooks for Scripted<'_> {
-    fn call(&mut self, data: &HookData, hook: HookId, _: &[Value]) -> Value {
+    fn call(&mut self, data: &HookData, hook: HookId, args: &[Value]) -> Value {
         self.calls[hook.index()] = self.calls[hook.index()].saturating_add(1);
+        self.args.push((hook.0 as u16, args.to_vec()));
         self.values[hook.index()]
             .clone()
             .unwrap_or_else(|| zero(self.ir, &data.ctrl.hooks[hook.index()].ret))
@@ -550,6 +553,7 @@ impl<'ir> Driven<'ir> {
             ir,
             values: vec![None; interp.controller().hooks.len()],
             calls: vec![0; interp.controller().hooks.len()],
+            args: Vec::new(),
         };
         Driven { ir, interp, hooks }
     }
@@ -565,6 +569,24 @@ impl<'ir> Driven<'ir> {
             .controller_by_name(sub)
             .and_then(|id| c.subordinate_index(id))
             .ok_or_else(|| rcs_runtime::driver::unknown(&c.name, "subordinate", sub))
+    }
+
+    /// Buffer `name` of `list` (the controller's `reads` or `writes`):
+    /// its index and `value` typed as it.
+    fn buffer_value(
+        &self,
+        list: &[BufferId],
+        kind: &str,
+        name: &str,
+        value: &Value,
+    ) -> Result<(usize, Value), rcs_runtime::driver::DriveError> {
+        let c = self.interp.controller();
+        let i = list
+            .iter()
+            .position(|b| self.ir.buffers[b.index()].name == name)
+            .ok_or_else(|| rcs_runtime::driver::unknown(&c.name, kind, name))?;
+        let ty = Type::Buffer(self.ir.buffers[list[i].index()].ty);
+        Ok((i, self.typed(&ty, name, value)?))
     }
 
     fn typed(
@@ -613,13 +635,7 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
         value: &Value,
     ) -> Result<(), rcs_runtime::driver::DriveError> {
         let c = self.interp.controller();
-        let i = c
-            .reads
-            .iter()
-            .position(|b| self.ir.buffers[b.index()].name == buffer)
-            .ok_or_else(|| rcs_runtime::driver::unknown(&c.name, "read buffer", buffer))?;
-        let ty = Type::Buffer(self.ir.buffers[c.reads[i].index()].ty);
-        let v = self.typed(&ty, buffer, value)?;
+        let (i, v) = self.buffer_value(&c.reads, "read buffer", buffer, value)?;
         self.interp.set_read(i, v);
         Ok(())
     }
@@ -637,6 +653,29 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
             .ok_or_else(|| rcs_runtime::driver::unknown(&c.name, "hook", hook))?;
         let v = self.typed(&c.hooks[i].ret, hook, value)?;
         self.hooks.values[i] = Some(v);
+        Ok(())
+    }
+
+    fn set_var(&mut self, var: &str, value: &Value) -> Result<(), rcs_runtime::driver::DriveError> {
+        let c = self.interp.controller();
+        let i = c
+            .vars
+            .iter()
+            .position(|v| v.name == var)
+            .ok_or_else(|| rcs_runtime::driver::unknown(&c.name, "var", var))?;
+        let v = self.typed(&c.vars[i].ty, var, value)?;
+        self.interp.vars[i] = v;
+        Ok(())
+    }
+
+    fn set_write(
+        &mut self,
+        buffer: &str,
+        value: &Value,
+    ) -> Result<(), rcs_runtime::driver::DriveError> {
+        let c = self.interp.controller();
+        let (i, v) = self.buffer_value(&c.writes, "write buffer", buffer, value)?;
+        self.interp.writes[i] = v;
         Ok(())
     }
 
@@ -658,6 +697,7 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
         let rec = self.interp.cycle(&mut self.hooks);
         let hook_calls = self.hooks.calls.clone();
         self.hooks.calls.fill(0);
+        let hook_args = std::mem::take(&mut self.hooks.args);
         let c = self.interp.controller();
         rcs_runtime::driver::Record {
             cycle: rec.cycle,
@@ -679,6 +719,7 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
             vars: rec.vars,
             writes: rec.writes,
             hook_calls,
+            hook_args,
         }
     }
 }

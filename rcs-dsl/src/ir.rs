@@ -375,14 +375,10 @@ impl Row {
         matches!(self.from, From::DontCare(_))
     }
 
-    /// Every name a scenario may use for this row: `EN`, `*N`, `otherwise`, `#N`.
+    /// The row's name everywhere — tables, graphs, diagnostics, coverage,
+    /// scenarios: `E` and its position, whether or not it is labelled.
     pub fn display_name(&self) -> String {
-        match (&self.label, &self.from) {
-            (Some(n), _) => format!("E{n}"),
-            (None, From::DontCare(Some(n))) => format!("*{n}"),
-            (None, _) if self.is_otherwise() => "otherwise".to_string(),
-            _ => format!("#{}", self.position),
-        }
+        format!("E{}", self.position)
     }
 }
 

@@ -24,6 +24,17 @@ pub fn from_str<T: DeserializeOwned>(text: &str) -> Result<T, YamlError> {
     })
 }
 
+/// [`from_str`] for documents of names (scenarios): only `true` and
+/// `false` are booleans, so `ON`, `OFF`, `YES`, `NO`, `Y`, `N` read as the
+/// names they are (YAML 1.2's reading, not 1.1's).
+pub fn from_str_names<T: DeserializeOwned>(text: &str) -> Result<T, YamlError> {
+    let options = serde_saphyr::options! { with_snippet: false, strict_booleans: true };
+    serde_saphyr::from_str_with_options(text, options).map_err(|e| YamlError {
+        message: message(e.to_string().lines().next().unwrap_or("")),
+        location: e.location(),
+    })
+}
+
 /// The library's message without what callers say themselves (the place,
 /// which they print as `file:line:`) or what only a programmer can act on
 /// (the library option that would let duplicate keys through).

@@ -49,9 +49,9 @@ fn figure13_principal_sequence_and_exception_loop() {
     let mut interp = Interpreter::new(&ir, gx);
     interp.command(CommandId(0), vec![]);
     let script: [(Option<usize>, &str, &str); 12] = [
-        (None, "*0", "S1"),    // new command → S1
+        (None, "E0", "S1"),    // new command → S1
         (Some(2), "E2", "S1"), // wait loop
-        (None, "*10", "S1"),   // nothing happens: otherwise NOP
+        (None, "E10", "S1"),   // nothing happens: otherwise NOP
         (Some(3), "E3", "S2"), // principal sequence
         (Some(4), "E4", "S3"), // exception
         (Some(5), "E5", "S3"), // exception wait loop
@@ -94,7 +94,7 @@ fn figure13_fault_from_any_state_ends_in_error() {
     let (fired, state, status) = step(&mut interp, &ir, None);
     assert_eq!(
         (fired.as_str(), state.as_str(), status),
-        ("*0", "S1", u32::from(rcs_runtime::Status::EXECUTING.0))
+        ("E0", "S1", u32::from(rcs_runtime::Status::EXECUTING.0))
     );
 }
 

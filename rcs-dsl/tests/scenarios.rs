@@ -54,10 +54,10 @@ fn a_wrong_expectation_fails_with_its_line_and_the_rows_so_far() {
     let s = scenario::parse(&ir, &file, "wrong_expectation").expect("well-formed");
     assert_eq!(s.name, "wrong_expectation");
     let out = scenario::run(&ir, &s);
-    let (line, report) = out.failure.expect("fails");
+    let (line, report) = out.failure.clone().expect("fails");
     assert_eq!(line, 10, "the failing step's line");
     assert_eq!(report, "fired: expected E2, got none");
-    assert_eq!(out.fired, ["E0", "-"]);
+    assert_eq!(out.fired_per_cycle().collect::<Vec<_>>(), ["E0", "-"]);
 }
 
 #[test]
@@ -188,46 +188,4 @@ fn names_the_plans_lack_are_refused_with_their_line() {
         assert_eq!(e.line, line, "{text}");
         assert!(e.message.contains(message), "{text}: {}", e.message);
     }
-}
-
-#[test]
-fn a_verb_yaml_reads_as_a_boolean_gets_a_hint_to_quote_it() {
-    let set = rcs_dsl::PlanSet::from_texts(
-        "switch",
-        [(
-            "s.rcs",
-            "controller P {\n    command ON\n    command OFF\n    plan ON { *0 when new_command -> Done }\n    plan OFF { *0 when new_command -> Done }\n}\n",
-        )],
-        None,
-    );
-    let ir = check(&set, &Options::default()).ir.expect("clean");
-    let parse = |text: &str| {
-        let file = SourceFile::new("t.scenario.yaml", text);
-        scenario::parse(&ir, &file, "t")
-            .err()
-            .map(|e| (e.line, e.message))
-    };
-    let (line, message) = parse("controller: P\nsteps:\n  - command: ON\n").expect("refused");
-    assert_eq!(line, 3);
-    assert!(
-        message.contains("YAML reads `ON` as the boolean `true`") && message.contains("`\"ON\"`"),
-        "{message}"
-    );
-    let (_, message) = parse("controller: P\nsteps:\n  - command: NO\n").expect("refused");
-    assert!(
-        message.contains("YAML reads `OFF` as the boolean `false`"),
-        "{message}"
-    );
-    // A plan set without such a verb still gets the general hint.
-    let (_, message) = parse_sub("controller: PR\nsteps:\n  - command: yes\n");
-    assert!(message.contains("quote such a verb"), "{message}");
-    // Quoted, it is a verb.
-    assert_eq!(parse("controller: P\nsteps:\n  - command: \"ON\"\n"), None);
-}
-
-fn parse_sub(text: &str) -> (usize, String) {
-    let ir = submarine();
-    let file = SourceFile::new("t.scenario.yaml", text);
-    let e = scenario::parse(&ir, &file, "t").err().expect("refused");
-    (e.line, e.message)
 }

@@ -297,6 +297,11 @@ pub struct Record {
     /// order (a condition's call counts once however many rows ask).
     #[serde(default)]
     pub hook_calls: Vec<u32>,
+    /// Each hook call this cycle that ran (not one answered from the
+    /// cycle's condition cache): the hook's index and its arguments, in
+    /// call order.
+    #[serde(default)]
+    pub hook_args: Vec<(u16, Vec<Value>)>,
 }
 
 /// One controller driven alone. Names are as written in the plans.
@@ -311,6 +316,12 @@ pub trait Driven {
     /// From now on hook `hook` returns `value` (until set again). Before it
     /// is set a hook returns its type's zero.
     fn set_hook(&mut self, hook: &str, value: &Value) -> Result<(), DriveError>;
+    /// Var `var` holds `value` from now on (until the plan assigns it):
+    /// how a scenario's `initial:` sets the world model.
+    fn set_var(&mut self, var: &str, value: &Value) -> Result<(), DriveError>;
+    /// The controller's own `writes` buffer `buffer` holds `value` from now
+    /// on (until a job writes it).
+    fn set_write(&mut self, buffer: &str, value: &Value) -> Result<(), DriveError>;
     /// Subordinate `sub` writes its status buffer (a new generation) before
     /// the next cycle. A subordinate not written is silent: its status
     /// goes stale.
@@ -354,6 +365,20 @@ pub enum Request {
         /// The hook.
         hook: String,
         /// What it returns.
+        value: Value,
+    },
+    /// [`Driven::set_var`].
+    SetVar {
+        /// The var.
+        var: String,
+        /// Its value.
+        value: Value,
+    },
+    /// [`Driven::set_write`].
+    SetWrite {
+        /// The buffer.
+        buffer: String,
+        /// Its value.
         value: Value,
     },
     /// [`Driven::write_sub_status`].
@@ -438,6 +463,8 @@ fn answer(d: &mut dyn Driven, request: Request) -> Response {
         Request::Command { verb, args } => serial(d.command(&verb, &args)),
         Request::SetRead { buffer, value } => done(d.set_read(&buffer, &value)),
         Request::SetHook { hook, value } => done(d.set_hook(&hook, &value)),
+        Request::SetVar { var, value } => done(d.set_var(&var, &value)),
+        Request::SetWrite { buffer, value } => done(d.set_write(&buffer, &value)),
         Request::WriteSubStatus { sub, status } => done(d.write_sub_status(&sub, status)),
         Request::LastSent { sub } => serial(d.last_sent(&sub)),
         Request::Cycle => Response::Record(d.cycle()),
@@ -550,6 +577,20 @@ impl<R: std::io::BufRead, W: std::io::Write> Driven for Remote<R, W> {
     fn set_hook(&mut self, hook: &str, value: &Value) -> Result<(), DriveError> {
         self.unit(&Request::SetHook {
             hook: hook.to_string(),
+            value: value.clone(),
+        })
+    }
+
+    fn set_var(&mut self, var: &str, value: &Value) -> Result<(), DriveError> {
+        self.unit(&Request::SetVar {
+            var: var.to_string(),
+            value: value.clone(),
+        })
+    }
+
+    fn set_write(&mut self, buffer: &str, value: &Value) -> Result<(), DriveError> {
+        self.unit(&Request::SetWrite {
+            buffer: buffer.to_string(),
             value: value.clone(),
         })
     }

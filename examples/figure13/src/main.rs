@@ -27,7 +27,7 @@ use figure13::{gx, Hooks, System};
 /// The rows of plan `RUN` by row id (precedence position), as written in
 /// `plans/figure13/figure13.rcs`.
 const ROWS: [(RowId, &str); 11] = [
-    (0, "*0: *0 when new_command -> S1"),
+    (0, "E0: *0 when new_command -> S1"),
     (1, "E1: *1 when ev.e1 -> Error(FAULT)"),
     (2, "E2: S1 when ev.e2 -> S1"),
     (3, "E3: S1 when ev.e3 -> S2"),
@@ -37,7 +37,7 @@ const ROWS: [(RowId, &str); 11] = [
     (7, "E7: S2 when ev.e7 -> S4"),
     (8, "E8: S4 when ev.e8 -> S4"),
     (9, "E9: S4 when ev.e9 -> Done"),
-    (10, "*10: otherwise -> same"),
+    (10, "E10: *10 otherwise -> same"),
 ];
 
 /// The script: the event sensory processing detects in each cycle (`None`:
@@ -76,7 +76,7 @@ fn events(e: Option<u8>) -> Events {
     ev
 }
 
-/// The short name of a row (`E3`, `*0`, `*10`).
+/// The name of a row, `E` and its position (`E0`, `E3`, `E10`).
 fn row_name(row: RowId) -> &'static str {
     row_text(row).split(':').next().unwrap_or("?")
 }

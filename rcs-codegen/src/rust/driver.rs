@@ -138,37 +138,47 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
     let hook_fns = c.hooks.iter().enumerate().map(|(hi, h)| {
         let id = &n.hooks[hi];
         let tys = h.params.iter().map(|p| rust_type(names, &p.ty));
-        let blanks = h.params.iter().map(|_| quote!(_));
+        let args: Vec<_> = (0..h.params.len())
+            .map(|k| format_ident!("a{}", k))
+            .collect();
         let i = proc_macro2::Literal::usize_unsuffixed(hi);
-        let count = quote!(self.call_counts[#i] = self.call_counts[#i].saturating_add(1););
+        let i16 = proc_macro2::Literal::u16_suffixed(hi as u16);
+        let count = quote! {
+            self.call_counts[#i] = self.call_counts[#i].saturating_add(1);
+            self.call_args.push((#i16, vec![#(#dv::ToValue::to_value(&#args)),*]));
+        };
         if h.ret == Type::Unit {
-            quote!(fn #id(&mut self, _: &Data #(, #blanks: #tys)*) { #count })
+            quote!(fn #id(&mut self, _: &Data #(, #args: #tys)*) { #count })
         } else {
             let ret = rust_type(names, &h.ret);
-            quote!(fn #id(&mut self, _: &Data #(, #blanks: #tys)*) -> #ret { #count self.#id })
+            quote!(fn #id(&mut self, _: &Data #(, #args: #tys)*) -> #ret { #count self.#id })
         }
     });
     let hook_count = proc_macro2::Literal::usize_unsuffixed(c.hooks.len());
     let hooks_default = if c.hooks.iter().all(|h| derivable_default(&h.ret)) {
         quote! {
-            #[derive(Clone, Copy, Debug, Default, PartialEq)]
+            #[derive(Clone, Debug, Default, PartialEq)]
             pub struct ScriptedHooks {
                 #(pub #hook_fields: #hook_tys,)*
                 /// Calls of each hook since the last cycle's record.
                 pub call_counts: [u32; #hook_count],
+                /// Those calls' hook indices and arguments, in order.
+                pub call_args: Vec<(u16, Vec<#dv::Value>)>,
             }
         }
     } else {
         let zeros = c.hooks.iter().map(|h| zero(names, &h.ret));
         quote! {
-            #[derive(Clone, Copy, Debug, PartialEq)]
+            #[derive(Clone, Debug, PartialEq)]
             pub struct ScriptedHooks {
                 #(pub #hook_fields: #hook_tys,)*
                 /// Calls of each hook since the last cycle's record.
                 pub call_counts: [u32; #hook_count],
+                /// Those calls' hook indices and arguments, in order.
+                pub call_args: Vec<(u16, Vec<#dv::Value>)>,
             }
             impl Default for ScriptedHooks {
-                fn default() -> Self { Self { #(#hook_fields: #zeros,)* call_counts: [0; #hook_count] } }
+                fn default() -> Self { Self { #(#hook_fields: #zeros,)* call_counts: [0; #hook_count], call_args: Vec::new() } }
             }
         }
     };
@@ -181,10 +191,12 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
         read_names,
         read_handles,
         write_fields,
+        write_names,
         sub_names,
         sub_modules,
         ..
     } = Wiring::new(ir, names, ci);
+    let var_names: Vec<&str> = c.vars.iter().map(|v| v.name.as_str()).collect();
     let var_fields = &n.vars;
     let sub_cmd: Vec<_> = n.subs.iter().map(|f| prefixed("cmd", f)).collect();
     let sub_status: Vec<_> = n.subs.iter().map(|f| prefixed("status", f)).collect();
@@ -254,6 +266,30 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
         )
     };
 
+    let (var_param, var_match) = if c.vars.is_empty() {
+        (quote!(_), quote!())
+    } else {
+        (
+            quote!(value),
+            quote!(#(#var_names => {
+                self.controller.data.vars.#var_fields = #dv::typed(NAME, var, value)?;
+                Ok(())
+            })*),
+        )
+    };
+    let (write_param, write_match) = if c.writes.is_empty() {
+        (quote!(_), quote!())
+    } else {
+        (
+            quote!(value),
+            quote!(#(#write_names => {
+                self.controller.data.writes.#write_fields = #dv::typed(NAME, buffer, value)?;
+                Ok(())
+            })*),
+        )
+    };
+    let var_match_body = by_name("var", "var", var_match);
+    let write_match_body = by_name("buffer", "write buffer", write_match);
     let read_match_body = by_name("buffer", "read buffer", read_match);
     let hook_match_body = by_name("hook", "hook", hook_match);
     let sub_match_body = by_name("sub", "subordinate", sub_match);
@@ -314,6 +350,14 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
                 #hook_match_body
             }
 
+            fn set_var(&mut self, var: &str, #var_param: &#dv::Value) -> Result<(), #dv::DriveError> {
+                #var_match_body
+            }
+
+            fn set_write(&mut self, buffer: &str, #write_param: &#dv::Value) -> Result<(), #dv::DriveError> {
+                #write_match_body
+            }
+
             fn write_sub_status(&mut self, sub: &str, #subs_param: rt::StatusBuffer) -> Result<(), #dv::DriveError> {
                 #sub_match_body
             }
@@ -333,6 +377,7 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
                 self.cycle += 1;
                 let hook_calls = self.controller.hooks().call_counts.to_vec();
                 self.controller.hooks_mut().call_counts = [0; #hook_count];
+                let hook_args = ::std::mem::take(&mut self.controller.hooks_mut().call_args);
                 let bk = self.controller.bookkeeping();
                 #bind_data
                 #dv::Record {
@@ -346,6 +391,7 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
                     vars: vec![#(#dv::ToValue::to_value(&data.vars.#var_fields)),*],
                     writes: vec![#(#dv::ToValue::to_value(&data.writes.#write_fields)),*],
                     hook_calls,
+                    hook_args,
                 }
             }
         }

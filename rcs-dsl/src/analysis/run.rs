@@ -172,17 +172,30 @@ pub fn scenario_text(run: &Run, name: &str, about: &str) -> Result<String, Strin
         m.insert(run.command.clone(), Json::Object(params));
         Json::Object(m)
     };
+    // A run holds a subordinate's status until set again, answering each
+    // new command; a scenario step's answer binds only that step, so every
+    // step repeats the answers in force.
+    let mut held: BTreeMap<String, String> = BTreeMap::new();
+    let held_per_step: Vec<BTreeMap<String, String>> = run
+        .steps
+        .iter()
+        .map(|s| {
+            held.extend(s.subordinates.clone());
+            held.clone()
+        })
+        .collect();
     let steps = run
         .steps
         .iter()
+        .zip(&held_per_step)
         .enumerate()
-        .map(|(i, s)| {
+        .map(|(i, (s, subordinates))| {
             let (fired, state) = s.expect.last(s.cycles);
             StepFile {
                 command: (i == 0).then(|| command.clone()),
                 reads: &s.reads,
                 hooks: &s.hooks,
-                subordinates: &s.subordinates,
+                subordinates,
                 cycles: s.cycles.max(1),
                 expect: ExpectFile {
                     fired: fired.unwrap_or("none"),
@@ -234,14 +247,14 @@ pub(crate) fn replay_on<'ir>(
         return Err(format!("line {line}: {report}"));
     }
     let want = run.fired_per_cycle();
-    if want.len() != outcome.fired.len() {
+    if want.len() as u64 != outcome.cycles() {
         return Err(format!(
             "{} cycles run, {} expected",
-            outcome.fired.len(),
+            outcome.cycles(),
             want.len()
         ));
     }
-    for (cycle, (w, got)) in want.iter().zip(&outcome.fired).enumerate() {
+    for (cycle, (w, got)) in want.iter().zip(outcome.fired_per_cycle()).enumerate() {
         let w = w.unwrap_or("-");
         if w != got {
             return Err(format!(
@@ -285,13 +298,8 @@ pub fn json_of(ir: &Ir, ty: &Type, v: &Value) -> Option<Json> {
     })
 }
 
-/// A row as a run and a scenario name it: `E3`, `*2`, `otherwise` or
-/// `#4` (a `*N` by its position, which a misnumbered row's label is not).
+/// A row as a run and a scenario name it: `E3`, its position, as
+/// everywhere else.
 pub fn row_name(row: &crate::ir::Row) -> String {
-    match (&row.label, &row.from) {
-        (Some(n), _) => format!("E{n}"),
-        (None, crate::ir::From::DontCare(_)) => format!("*{}", row.position),
-        (None, _) if row.is_otherwise() => "otherwise".to_string(),
-        _ => format!("#{}", row.position),
-    }
+    format!("E{}", row.position)
 }

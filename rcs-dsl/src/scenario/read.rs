@@ -1,0 +1,513 @@
+//! Reading a scenario: the first part of `rcsc test` after the plans are
+//! checked. The YAML (through [`crate::yaml`], booleans only `true` and
+//! `false`, so that `command: ON` is a verb) is read into raw types, then
+//! every name is resolved against the controller of the IR and every value
+//! typed ([`super::values`]), so that a scenario that runs names only what
+//! exists. Every problem is a [`ScenarioError`] with its line.
+
+use super::report::{row_aliases, row_name};
+use super::values::{merge, value, verb_call};
+use super::{err, Called, Echo, Expect, Scenario, ScenarioError, Step, SubSetting, MAX_CYCLES};
+use crate::interp::{zero, Value};
+use crate::ir::*;
+use crate::source::SourceFile;
+use crate::yaml::{self, Spanned};
+use serde::Deserialize;
+use serde_json::Value as Json;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawScenario {
+    name: Option<String>,
+    controller: Spanned<String>,
+    initial: Option<RawSettings>,
+    steps: Vec<Spanned<RawStep>>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawSettings {
+    reads: Option<Entries>,
+    hooks: Option<Entries>,
+    subordinates: Option<Entries>,
+    vars: Option<Entries>,
+    writes: Option<Entries>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawStep {
+    command: Option<Spanned<Json>>,
+    reads: Option<Entries>,
+    hooks: Option<Entries>,
+    subordinates: Option<Entries>,
+    cycles: Option<Spanned<Json>>,
+    expect: Option<RawExpect>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawExpect {
+    fired: Option<Spanned<Json>>,
+    state: Option<Spanned<String>>,
+    status: Option<Spanned<String>>,
+    error: Option<Spanned<String>>,
+    sent: Option<Entries>,
+    vars: Option<Entries>,
+    writes: Option<Entries>,
+    hooks_called: Option<Entries>,
+}
+
+/// A YAML mapping of names to values (`reads:`, `hooks:`, `sent:` …), in
+/// file order, each entry with the line of its key, so that a name the
+/// plans lack is reported on its own line.
+#[derive(Default)]
+struct Entries(Vec<Entry>);
+
+struct Entry {
+    line: usize,
+    name: String,
+    value: Json,
+}
+
+impl<'de> Deserialize<'de> for Entries {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = Entries;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a mapping of names to values")
+            }
+            fn visit_unit<E>(self) -> Result<Entries, E> {
+                Ok(Entries::default())
+            }
+            fn visit_none<E>(self) -> Result<Entries, E> {
+                Ok(Entries::default())
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                mut m: A,
+            ) -> Result<Entries, A::Error> {
+                let mut out = Vec::new();
+                // Duplicate keys are refused by the YAML reader itself.
+                while let Some(key) = m.next_key::<Spanned<String>>()? {
+                    out.push(Entry {
+                        line: line_of(&key),
+                        name: key.value,
+                        value: m.next_value()?,
+                    });
+                }
+                Ok(Entries(out))
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
+}
+
+/// The line a scenario value was written on.
+fn line_of<T>(s: &Spanned<T>) -> usize {
+    s.referenced.line() as usize
+}
+
+/// The entries of an optional mapping: (line of the key, name, value).
+fn entries(e: &Option<Entries>) -> impl Iterator<Item = (usize, &str, &Json)> {
+    e.as_ref()
+        .map_or(&[][..], |e| &e.0)
+        .iter()
+        .map(|e| (e.line, e.name.as_str(), &e.value))
+}
+
+/// Read and resolve a scenario. `stem` names it when it has no `name:`.
+pub fn parse(ir: &Ir, file: &SourceFile, stem: &str) -> Result<Scenario, ScenarioError> {
+    let raw: RawScenario = yaml::from_str_names(&file.text)
+        .map_err(|e| err(e.location.map_or(1, |l| l.line() as usize), e.message))?;
+    let cline = line_of(&raw.controller);
+    let ctrl = ir
+        .controller_by_name(&raw.controller.value)
+        .ok_or_else(|| {
+            err(
+                cline,
+                format!("unknown controller `{}`", raw.controller.value),
+            )
+        })?;
+    let r = Resolver {
+        ir,
+        c: ir.controller(ctrl),
+    };
+    let s = raw.initial.unwrap_or_default();
+    let mut initial = r.step(cline, None, s.reads, s.hooks, s.subordinates, None, None)?;
+    initial.vars = r.vars(&s.vars)?;
+    initial.writes = r.writes(&s.writes)?;
+    let mut steps = Vec::new();
+    for s in raw.steps {
+        let line = line_of(&s);
+        let v = s.value;
+        steps.push(r.step(
+            line,
+            v.command,
+            v.reads,
+            v.hooks,
+            v.subordinates,
+            v.cycles,
+            v.expect,
+        )?);
+    }
+    Ok(Scenario {
+        name: raw.name.unwrap_or_else(|| stem.to_string()),
+        controller: ctrl,
+        initial,
+        steps,
+    })
+}
+
+struct Resolver<'a> {
+    ir: &'a Ir,
+    c: &'a Controller,
+}
+
+impl Resolver<'_> {
+    #[allow(clippy::too_many_arguments)]
+    fn step(
+        &self,
+        line: usize,
+        command: Option<Spanned<Json>>,
+        reads: Option<Entries>,
+        hooks: Option<Entries>,
+        subs: Option<Entries>,
+        cycles: Option<Spanned<Json>>,
+        expect: Option<RawExpect>,
+    ) -> Result<Step, ScenarioError> {
+        let command = command
+            .map(|c| self.command(line_of(&c), &c.value))
+            .transpose()?;
+        let mut read_list = Vec::new();
+        for (line, name, v) in entries(&reads) {
+            let i = self
+                .c
+                .reads
+                .iter()
+                .position(|b| self.ir.buffers[b.index()].name == *name)
+                .ok_or_else(|| err(line, format!("`{}` reads no buffer `{name}`", self.c.name)))?;
+            // Check the shape now; values merge into the current buffer when run.
+            let ty = Type::Buffer(self.ir.buffers[self.c.reads[i].index()].ty);
+            merge(self.ir, line, &zero(self.ir, &ty), &ty, v, name)?;
+            read_list.push((i, v.clone()));
+        }
+        let mut hook_list = Vec::new();
+        for (line, name, v) in entries(&hooks) {
+            let h = self
+                .c
+                .hooks
+                .iter()
+                .position(|h| h.name == *name)
+                .ok_or_else(|| err(line, format!("`{}` has no hook `{name}`", self.c.name)))?;
+            let value = value(self.ir, line, &self.c.hooks[h].ret, v, name)?;
+            hook_list.push((HookId(h as u32), value));
+        }
+        let mut sub_list = Vec::new();
+        for (line, name, v) in entries(&subs) {
+            let i = self.sub_index(line, name)?;
+            let sub = self.ir.controller(self.c.subordinates[i]);
+            sub_list.push((i, self.sub_setting(line, sub, v)?));
+        }
+        let expect = match expect {
+            Some(e) => self.expect(e)?,
+            None => Expect::default(),
+        };
+        Ok(Step {
+            line,
+            command,
+            reads: read_list,
+            hooks: hook_list,
+            subs: sub_list,
+            vars: Vec::new(),
+            writes: Vec::new(),
+            cycles: cycles.map_or(Ok(1), |c| self.cycles(&c))?,
+            expect,
+        })
+    }
+
+    /// `cycles: N`, 1 to [`MAX_CYCLES`].
+    fn cycles(&self, c: &Spanned<Json>) -> Result<u64, ScenarioError> {
+        let n = match &c.value {
+            Json::Number(n) => n.as_u64(),
+            _ => None,
+        };
+        n.filter(|n| (1..=MAX_CYCLES).contains(n)).ok_or_else(|| {
+            err(
+                line_of(c),
+                format!(
+                    "`cycles` is a whole number from 1 to {MAX_CYCLES}, not `{}`",
+                    c.value
+                ),
+            )
+        })
+    }
+
+    /// `vars:` (in `initial:` and `expect:`): each a whole value.
+    fn vars(&self, e: &Option<Entries>) -> Result<Vec<(usize, Value)>, ScenarioError> {
+        let mut out = Vec::new();
+        for (line, name, v) in entries(e) {
+            let i = self
+                .c
+                .vars
+                .iter()
+                .position(|x| x.name == *name)
+                .ok_or_else(|| err(line, format!("`{}` has no var `{name}`", self.c.name)))?;
+            out.push((i, value(self.ir, line, &self.c.vars[i].ty, v, name)?));
+        }
+        Ok(out)
+    }
+
+    /// `writes:` (in `initial:` and `expect:`): fields of the controller's
+    /// own buffers, checked now and merged when used.
+    fn writes(&self, e: &Option<Entries>) -> Result<Vec<(usize, Json)>, ScenarioError> {
+        let mut out = Vec::new();
+        for (line, name, v) in entries(e) {
+            let i = self
+                .c
+                .writes
+                .iter()
+                .position(|b| self.ir.buffers[b.index()].name == *name)
+                .ok_or_else(|| err(line, format!("`{}` writes no buffer `{name}`", self.c.name)))?;
+            let ty = Type::Buffer(self.ir.buffers[self.c.writes[i].index()].ty);
+            merge(self.ir, line, &zero(self.ir, &ty), &ty, v, name)?;
+            out.push((i, v.clone()));
+        }
+        Ok(out)
+    }
+
+    /// `hooks_called.NAME`: a count, or a list of calls, each a mapping of
+    /// parameter names to the arguments expected.
+    fn called(&self, line: usize, hook: &Hook, v: &Json) -> Result<Called, ScenarioError> {
+        let shape = || {
+            err(
+                line,
+                format!(
+                    "`hooks_called.{}` is how many times the step called it (0 or more), or its calls: `[{{ param: value }}, …]`",
+                    hook.name
+                ),
+            )
+        };
+        let calls = match v {
+            Json::Number(n) => return n.as_u64().map(Called::Times).ok_or_else(shape),
+            Json::Array(calls) => calls,
+            _ => return Err(shape()),
+        };
+        let mut out = Vec::new();
+        for call in calls {
+            let Json::Object(m) = call else {
+                return Err(shape());
+            };
+            let mut args = vec![None; hook.params.len()];
+            for (k, x) in m {
+                let p = hook
+                    .params
+                    .iter()
+                    .position(|p| p.name == *k)
+                    .ok_or_else(|| {
+                        err(line, format!("hook `{}` has no parameter `{k}`", hook.name))
+                    })?;
+                args[p] = Some(value(self.ir, line, &hook.params[p].ty, x, k)?);
+            }
+            out.push(args);
+        }
+        Ok(Called::With(out))
+    }
+
+    /// The rows of the controller's plans, for a hint: `AHEAD: E0–E4; INIT: E0–E1`.
+    fn rows_hint(&self) -> String {
+        let plans: Vec<String> = self
+            .c
+            .plans
+            .iter()
+            .map(|p| {
+                let verb = self
+                    .c
+                    .commands
+                    .get(p.verb.index())
+                    .map_or("?", |k| k.name.as_str());
+                match p.rows.len() {
+                    0 => format!("{verb}: no rows"),
+                    1 => format!("{verb}: E0"),
+                    n => format!("{verb}: E0–{}", row_name(n as u32 - 1)),
+                }
+            })
+            .collect();
+        format!("its rows are {} (or `none`)", plans.join("; "))
+    }
+
+    /// `INIT` or `{ AHEAD: { speed: 10.0 } }`.
+    fn command(&self, line: usize, v: &Json) -> Result<(CommandId, Vec<Value>), ScenarioError> {
+        verb_call(self.ir, self.c, line, v, || {
+            "`command` is a verb (`INIT`) or `{ VERB: { param: value } }`".to_string()
+        })
+    }
+
+    /// The index of subordinate `name` in this controller's `subordinates`.
+    fn sub_index(&self, line: usize, name: &str) -> Result<usize, ScenarioError> {
+        self.ir
+            .controller_by_name(name)
+            .and_then(|id| self.c.subordinate_index(id))
+            .ok_or_else(|| {
+                err(
+                    line,
+                    format!("`{name}` is not a subordinate of `{}`", self.c.name),
+                )
+            })
+    }
+
+    fn sub_setting(
+        &self,
+        line: usize,
+        sub: &Controller,
+        v: &Json,
+    ) -> Result<SubSetting, ScenarioError> {
+        let status_of = |name: &str| {
+            sub.statuses
+                .iter()
+                .position(|s| s.name == name)
+                .map(|i| i as u16)
+                .ok_or_else(|| err(line, format!("`{}` has no status `{name}`", sub.name)))
+        };
+        match v {
+            Json::String(s) => Ok(SubSetting {
+                status: status_of(s)?,
+                echo: Echo::Current,
+                silent: false,
+            }),
+            Json::Object(m) => {
+                let mut s = SubSetting {
+                    status: 0,
+                    echo: Echo::Current,
+                    silent: false,
+                };
+                for (k, x) in m {
+                    match (k.as_str(), x) {
+                        ("status", Json::String(n)) => s.status = status_of(n)?,
+                        ("echo", Json::String(e)) if e == "current" => s.echo = Echo::Current,
+                        ("echo", Json::String(e)) if e == "previous" => s.echo = Echo::Previous,
+                        ("echo", Json::Number(n)) => {
+                            s.echo = Echo::Literal(n.as_u64().and_then(|n| u32::try_from(n).ok()).ok_or_else(|| err(line, "`echo` is a serial (0 to 4294967295)"))?)
+                        }
+                        ("silent", Json::Bool(b)) => s.silent = *b,
+                        (k, _) => return Err(err(line, format!("bad subordinate setting `{k}`: expected `status: NAME`, `echo: current|previous|N`, `silent: true|false`"))),
+                    }
+                }
+                Ok(s)
+            }
+            _ => Err(err(
+                line,
+                format!(
+                    "subordinate `{}`: expected a status name or `{{ status, echo, silent }}`",
+                    sub.name
+                ),
+            )),
+        }
+    }
+
+    fn expect(&self, e: RawExpect) -> Result<Expect, ScenarioError> {
+        let mut out = Expect::default();
+        if let Some(f) = e.fired {
+            let line = line_of(&f);
+            let name = match &f.value {
+                Json::String(s) => s.clone(),
+                _ => return Err(err(line, "`fired` is a row name (`E3`) or `none`")),
+            };
+            if name == "none" {
+                out.fired = Some(None);
+            } else {
+                let known = self
+                    .c
+                    .plans
+                    .iter()
+                    .flat_map(|p| &p.rows)
+                    .any(|r| row_aliases(r).contains(&name));
+                if !known {
+                    return Err(err(
+                        line,
+                        format!(
+                            "no row of `{}` is called `{name}`: {}",
+                            self.c.name,
+                            self.rows_hint()
+                        ),
+                    ));
+                }
+                out.fired = Some(Some(name));
+            }
+        }
+        if let Some(s) = e.state {
+            let (line, s) = (line_of(&s), s.value);
+            let known = s == "S0"
+                || self
+                    .c
+                    .plans
+                    .iter()
+                    .flat_map(|p| &p.states)
+                    .any(|x| x.name == s);
+            if !known {
+                return Err(err(
+                    line,
+                    format!("no plan of `{}` has a state `{s}`", self.c.name),
+                ));
+            }
+            out.state = Some(s);
+        }
+        if let Some(s) = e.status {
+            let (line, s) = (line_of(&s), s.value);
+            let i = self
+                .c
+                .statuses
+                .iter()
+                .position(|x| x.name == s)
+                .ok_or_else(|| err(line, format!("`{}` has no status `{s}`", self.c.name)))?;
+            out.status = Some(i as u16);
+        }
+        if let Some(x) = e.error {
+            let (line, x) = (line_of(&x), x.value);
+            out.error = Some(match x.as_str() {
+                "none" => None,
+                "UNKNOWN_COMMAND" => Some(rcs_runtime::ErrorCode::UNKNOWN_COMMAND.0),
+                name => {
+                    let i = self
+                        .c
+                        .errors
+                        .iter()
+                        .position(|x| x.name == name)
+                        .ok_or_else(|| {
+                            err(
+                                line,
+                                format!("`{}` has no error code `{name}`", self.c.name),
+                            )
+                        })?;
+                    Some(rcs_runtime::ErrorCode::custom(i as u16).0)
+                }
+            });
+        }
+        if e.sent.is_some() {
+            let mut list = Vec::new();
+            for (line, name, v) in entries(&e.sent) {
+                let si = self.sub_index(line, name)?;
+                let sub = self.ir.controller(self.c.subordinates[si]);
+                let (cmd, vals) = verb_call(self.ir, sub, line, v, || {
+                    format!("`sent.{name}` is a verb or `{{ VERB: {{ param: value }} }}`")
+                })?;
+                list.push((self.c.subordinates[si], cmd, vals));
+            }
+            out.sent = Some(list);
+        }
+        out.vars = self.vars(&e.vars)?;
+        out.writes = self.writes(&e.writes)?;
+        for (line, name, v) in entries(&e.hooks_called) {
+            let h = self
+                .c
+                .hooks
+                .iter()
+                .position(|h| h.name == *name)
+                .ok_or_else(|| err(line, format!("`{}` has no hook `{name}`", self.c.name)))?;
+            out.hooks_called
+                .push((HookId(h as u32), self.called(line, &self.c.hooks[h], v)?));
+        }
+        Ok(out)
+    }
+}

@@ -1,0 +1,104 @@
+//! The scenario reader and runner under hostile input: the project's
+//! scenarios with pieces of YAML spliced in anywhere are either refused
+//! with a line inside the file or run to an outcome — never a panic.
+//! `RCS_SCENARIO_CASES` raises the number of cases for a long run.
+
+use proptest::prelude::*;
+use rcs_dsl::scenario;
+use rcs_dsl::source::SourceFile;
+use rcs_dsl::{check, load_folder, Options};
+use std::path::Path;
+
+const PIECES: &[&str] = &[
+    "0",
+    "-1",
+    "4294967296",
+    "99999999999999999999",
+    "1e400",
+    ".nan",
+    "ON",
+    "NO",
+    "y",
+    "~",
+    "null",
+    "[",
+    "]",
+    "{",
+    "}",
+    ":",
+    ",",
+    "\n",
+    "\r",
+    "\t",
+    " ",
+    "\"",
+    "'",
+    "E99",
+    "#9",
+    "*",
+    "&a ",
+    "*a",
+    "!!binary ",
+    "- ",
+    "? ",
+    "cycles: 0",
+    "cycles: 10000001",
+    "{ 3: 1.5 }",
+    "[1.0, 2.0]",
+    "echo: previous",
+    "silent: true",
+    "hooks_called: { x: 1 }",
+    "\u{feff}",
+    "é",
+];
+
+fn scenarios() -> Vec<String> {
+    let dir = Path::new("../plans/submarine/scenarios");
+    let mut paths: Vec<_> = std::fs::read_dir(dir)
+        .expect("scenarios")
+        .map(|e| e.expect("entry").path())
+        .collect();
+    paths.sort();
+    paths
+        .iter()
+        .map(|p| std::fs::read_to_string(p).expect("text"))
+        .collect()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(
+        std::env::var("RCS_SCENARIO_CASES").ok().and_then(|n| n.parse().ok()).unwrap_or(256)
+    ))]
+
+    #[test]
+    fn spliced_scenarios_are_refused_with_a_line_or_run(
+        which in any::<prop::sample::Index>(),
+        cuts in prop::collection::vec((any::<prop::sample::Index>(), prop::sample::select(PIECES), 0usize..4), 1..4),
+    ) {
+        let set = load_folder(Path::new("../plans/submarine")).expect("plans");
+        let ir = check(&set, &Options::default()).ir.expect("clean");
+        let all = scenarios();
+        let mut text = all[which.index(all.len())].clone();
+        for (at, piece, removed) in cuts {
+            let mut i = at.index(text.len() + 1);
+            while !text.is_char_boundary(i) {
+                i -= 1;
+            }
+            let mut end = (i + removed).min(text.len());
+            while !text.is_char_boundary(end) {
+                end += 1;
+            }
+            text.replace_range(i..end, piece);
+        }
+        let lines = text.lines().count().max(1);
+        match scenario::parse(&ir, &SourceFile::new("t.scenario.yaml", text.clone()), "t") {
+            Err(e) => prop_assert!(e.line >= 1 && e.line <= lines + 1, "line {} of {lines}: {}\n{text}", e.line, e.message),
+            Ok(s) => {
+                // Keep the run short: a splice may ask for millions of cycles.
+                if !text.contains("cycles: 1000") && !text.contains("99999") {
+                    let _ = scenario::run(&ir, &s);
+                }
+            }
+        }
+    }
+}

@@ -180,9 +180,24 @@ pub struct Loaded {
 
 pub fn load(ir: &Ir, path: &Path) -> Loaded {
     let shown = rcs_dsl::load::display(path);
-    let scenario = match std::fs::read_to_string(path) {
+    let text = std::fs::read(path).map(String::from_utf8);
+    let scenario = match text {
         Err(e) => Err((0, format!("cannot read: {e}"))),
-        Ok(text) => {
+        Ok(Err(e)) => {
+            // Where the first bad byte is, as for a plan file.
+            let mut offset = e.utf8_error().valid_up_to();
+            let lossy = String::from_utf8_lossy(e.as_bytes());
+            if lossy.starts_with(rcs_dsl::source::BOM) {
+                offset -= rcs_dsl::source::BOM.len_utf8();
+            }
+            let file = SourceFile::new(shown.clone(), lossy.into_owned());
+            let (line, column) = file.line_col(offset);
+            Err((
+                line,
+                format!("not valid UTF-8 (first bad byte at line {line}, column {column}); save the file as UTF-8"),
+            ))
+        }
+        Ok(Ok(text)) => {
             let stem = path
                 .file_name()
                 .map(|n| n.to_string_lossy().into_owned())

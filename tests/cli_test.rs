@@ -127,10 +127,21 @@ fn scenario_mistakes_are_refused_with_their_line() {
             ),
         ],
     );
+    // A Latin-1 byte in a comment on line 3.
+    std::fs::write(
+        dir.join("scenarios/not_utf8.scenario.yaml"),
+        b"controller: A\nsteps:\n  - command: FILL # caf\xe9\n",
+    )
+    .unwrap();
     let out = rcsc_in(&dir, &["test"]);
     let stdout = text(&out.stdout);
     assert_eq!(out.status.code(), Some(1), "{stdout}{}", text(&out.stderr));
     for (file, line, message) in [
+        (
+            "not_utf8",
+            3,
+            "not valid UTF-8 (first bad byte at line 3, column 24)",
+        ),
         ("bad_controller", 1, "unknown controller `B`"),
         ("bad_field", 4, "has no field `depth`"),
         (
@@ -152,7 +163,7 @@ fn scenario_mistakes_are_refused_with_their_line() {
             "{file}: {message}\n{stdout}"
         );
     }
-    assert_eq!(stdout.lines().last(), Some("0 passed, 5 failed"));
+    assert_eq!(stdout.lines().last(), Some("0 passed, 6 failed"));
     std::fs::remove_dir_all(dir).ok();
 }
 

@@ -372,17 +372,21 @@ fn lower_controller_headers<'a>(
         let mut level_seen: Option<Span> = None;
         for e in &c.entries {
             match &e.kind {
-                ast::EntryKind::Level(n, span) => {
+                ast::EntryKind::Level(n, _) => {
                     if let Some(first) = level_seen {
-                        diags.push(duplicate(
-                            "`level` of controller",
-                            &c.name.text,
-                            *span,
-                            first,
-                        ));
+                        diags.push(
+                            Diagnostic::error(
+                                Code::DuplicateDefinition,
+                                format!("controller `{}` gives its `level` twice", c.name.text),
+                                e.span,
+                                "second `level`",
+                            )
+                            .with_secondary(first, "first `level` here")
+                            .with_help("keep one `level` line"),
+                        );
                         continue;
                     }
-                    level_seen = Some(*span);
+                    level_seen = Some(e.span);
                     ir.controllers[i].level = Some((*n).min(u32::MAX as u64) as u32);
                 }
                 ast::EntryKind::Subordinates(names) => {

@@ -2,6 +2,10 @@
 //! sets of 100 and 1,000 controllers × 10 plans, spread over files of ten
 //! controllers each, in a tree with five subordinates per supervisor.
 //!
+//! `check/parse_and_lower/N` times the front end alone on the same sets,
+//! so the checks (and the analysis of conditions in them) are the
+//! difference.
+//!
 //! Run: `cargo bench -p rcs-dsl --bench check`
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
@@ -105,6 +109,11 @@ fn bench_check(c: &mut Criterion) {
         group.throughput(Throughput::Bytes(bytes as u64));
         group.bench_with_input(BenchmarkId::new("controllers", n), &set, |b, set| {
             b.iter(|| check(set, &Options::default()))
+        });
+        // The front end alone (parsing and lowering, no checks): the rest
+        // of `check` is the checks, the analysis of conditions most of it.
+        group.bench_with_input(BenchmarkId::new("parse_and_lower", n), &set, |b, set| {
+            b.iter(|| rcs_dsl::lower_unchecked(set))
         });
     }
     group.finish();

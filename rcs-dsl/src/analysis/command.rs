@@ -300,6 +300,9 @@ impl PlanAnalysis<'_> {
                 && self.free_of(i, fixed)
                 && match &self.conds[i] {
                     None => true,
+                    // Without `new_command` in it, the condition is judged
+                    // as the graph already judged it (a proof remembered).
+                    Some(_) if self.free_of(i, &[self.new_command]) => !self.never_matches(i),
                     Some(c) => {
                         let f = Formula::Shared(c.clone());
                         !matches!(self.prove(&f, &later), Outcome::None)

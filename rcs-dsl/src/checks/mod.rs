@@ -95,30 +95,12 @@ pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagno
     }
     plan::check_missing_plans(ir, &mut sink);
     names::check_case_collisions(ir, &mut sink);
-    // The analysis of every plan's conditions and its graph first: the
-    // checks of a plan ask its own, the handshake checks their
-    // subordinates'.
-    let (conditions, graphs) = analyse_plans(ir);
-    for (ci, c) in ir.controllers.iter().enumerate() {
-        for (pi, p) in c.plans.iter().enumerate() {
-            let (conditions, analysis) = (&conditions[ci][pi], &graphs[ci][pi]);
-            plan::check_row_numbers(c, p, &mut sink);
-            plan::check_otherwise(p, &mut sink);
-            plan::check_entry(p, &mut sink);
-            plan::check_double_commands(ir, p, &mut sink);
-            plan::check_rule_of_ten(ir, c, p, &mut sink);
-            plan::check_unreachable_rows(p, analysis, &mut sink);
-            let bound = hang::entry_bound_rows(p, analysis, conditions);
-            hang::check_entry_bound_rows(p, &bound, conditions, &mut sink);
-            let bound: Vec<usize> = bound.iter().map(|b| b.row).collect();
-            plan::check_shadowed_rows(c, p, analysis, conditions, &bound, &mut sink);
-            graph::check_unreachable_states(c, p, analysis, &mut sink);
-            graph::check_dead_ends(c, p, analysis, &mut sink);
-            graph::check_no_done(ir, c, p, analysis, &mut sink);
-            hang::check_incomplete_states(c, p, conditions, analysis, &mut sink);
-            loops::check_livelocks(c, p, conditions, &mut sink);
-            loops::check_command_storms(ir, c, p, conditions, &mut sink);
-        }
+    // The analysis of every plan's conditions and its graph, and the
+    // checks of each plan, controller by controller on worker threads; the
+    // handshake checks then ask the subordinates' analyses.
+    let (conditions, graphs, found) = analyse_plans(ir, levels);
+    for d in found {
+        sink.diags.extend(d);
     }
     let plans = handshake::Plans { conditions, graphs };
     handshake::check_unhandled_error(ir, &plans, &mut sink);
@@ -130,39 +112,84 @@ pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagno
     diags.sort_from(start, sources);
 }
 
-/// Per controller, per plan: the analysis of its conditions, and its graph.
-type Analysed<'ir> = (Vec<Vec<PlanAnalysis<'ir>>>, Vec<Vec<graph::Analysis>>);
+/// Per controller: the analysis of each plan's conditions, each plan's
+/// graph, and the findings of the checks of its plans.
+type Analysed<'ir> = (
+    Vec<Vec<PlanAnalysis<'ir>>>,
+    Vec<Vec<graph::Analysis>>,
+    Vec<Diagnostics>,
+);
 
-/// The analysis of every plan and its graph (which asks the analysis most
-/// of the questions the checks need, and remembers the proofs), on as many
-/// threads as the machine has: plans are independent, and this is most of
-/// the time of the checks. Results come back in controller order, so the
-/// findings do not depend on the threads.
-fn analyse_plans(ir: &Ir) -> Analysed<'_> {
-    fn analyse<'ir>(
-        ir: &'ir Ir,
-        c: &'ir Controller,
-    ) -> (Vec<PlanAnalysis<'ir>>, Vec<graph::Analysis>) {
-        let conditions: Vec<PlanAnalysis> = c
-            .plans
-            .iter()
-            .map(|p| PlanAnalysis::new(ir, c, p))
-            .collect();
-        let graphs = c
-            .plans
-            .iter()
-            .zip(&conditions)
-            .map(|(p, a)| graph::analyse(p, a))
-            .collect();
-        (conditions, graphs)
+/// One controller's plans: analysed, then checked one by one.
+fn analyse_controller<'ir>(
+    ir: &'ir Ir,
+    c: &'ir Controller,
+    levels: &LintLevels,
+) -> (Vec<PlanAnalysis<'ir>>, Vec<graph::Analysis>, Diagnostics) {
+    let conditions: Vec<PlanAnalysis> = c
+        .plans
+        .iter()
+        .map(|p| PlanAnalysis::new(ir, c, p))
+        .collect();
+    let graphs: Vec<graph::Analysis> = c
+        .plans
+        .iter()
+        .zip(&conditions)
+        .map(|(p, a)| graph::analyse(p, a))
+        .collect();
+    let mut diags = Diagnostics::new();
+    let mut sink = Sink {
+        levels,
+        diags: &mut diags,
+    };
+    for ((p, conditions), analysis) in c.plans.iter().zip(&conditions).zip(&graphs) {
+        check_plan(ir, c, p, conditions, analysis, &mut sink);
     }
+    (conditions, graphs, diags)
+}
+
+/// The checks of one plan, over its analysis and graph.
+fn check_plan(
+    ir: &Ir,
+    c: &Controller,
+    p: &Plan,
+    conditions: &PlanAnalysis,
+    analysis: &graph::Analysis,
+    sink: &mut Sink,
+) {
+    plan::check_row_numbers(c, p, sink);
+    plan::check_otherwise(p, sink);
+    plan::check_entry(p, sink);
+    plan::check_double_commands(ir, p, sink);
+    plan::check_rule_of_ten(ir, c, p, sink);
+    plan::check_unreachable_rows(p, analysis, sink);
+    let bound = hang::entry_bound_rows(p, analysis, conditions);
+    hang::check_entry_bound_rows(p, &bound, conditions, sink);
+    let bound: Vec<usize> = bound.iter().map(|b| b.row).collect();
+    plan::check_shadowed_rows(c, p, analysis, conditions, &bound, sink);
+    graph::check_unreachable_states(c, p, analysis, sink);
+    graph::check_dead_ends(c, p, analysis, sink);
+    graph::check_no_done(ir, c, p, analysis, sink);
+    hang::check_incomplete_states(c, p, conditions, analysis, sink);
+    loops::check_livelocks(c, p, conditions, sink);
+    loops::check_command_storms(ir, c, p, conditions, sink);
+}
+
+/// [`analyse_controller`] for every controller, on as many threads as the
+/// machine has: controllers are independent, and this is most of the time
+/// of the checks. Results come back in controller order, so the findings
+/// (and their order) do not depend on the threads.
+fn analyse_plans<'ir>(ir: &'ir Ir, levels: &LintLevels) -> Analysed<'ir> {
     let plans: usize = ir.controllers.iter().map(|c| c.plans.len()).sum();
     let threads = std::thread::available_parallelism()
         .map_or(1, |n| n.get())
         .min(ir.controllers.len());
     // Below a few dozen plans a thread costs more than it saves.
     let per_controller: Vec<_> = if threads < 2 || plans < 64 {
-        ir.controllers.iter().map(|c| analyse(ir, c)).collect()
+        ir.controllers
+            .iter()
+            .map(|c| analyse_controller(ir, c, levels))
+            .collect()
     } else {
         let chunk = ir.controllers.len().div_ceil(threads);
         std::thread::scope(|scope| {
@@ -170,7 +197,11 @@ fn analyse_plans(ir: &Ir) -> Analysed<'_> {
                 .controllers
                 .chunks(chunk)
                 .map(|part| {
-                    scope.spawn(move || part.iter().map(|c| analyse(ir, c)).collect::<Vec<_>>())
+                    scope.spawn(move || {
+                        part.iter()
+                            .map(|c| analyse_controller(ir, c, levels))
+                            .collect::<Vec<_>>()
+                    })
                 })
                 .collect();
             handles
@@ -179,5 +210,11 @@ fn analyse_plans(ir: &Ir) -> Analysed<'_> {
                 .collect()
         })
     };
-    per_controller.into_iter().unzip()
+    let mut out: Analysed = (Vec::new(), Vec::new(), Vec::new());
+    for (a, g, d) in per_controller {
+        out.0.push(a);
+        out.1.push(g);
+        out.2.push(d);
+    }
+    out
 }

@@ -1,8 +1,9 @@
 //! The analysis of conditions, one plan at a time: every plan of the
 //! project's plan sets and of the golden corpus (`plans/`, `tests/data/`),
-//! each put through every proof the checks can ask of it (each row can
+//! each put through everything the checks can ask of it: each row can
 //! match; each row can fire in each state; each row can fire while each
-//! other row holds, in each state). Prints the slowest plans of ≤ 10 rows
+//! other row holds, in each state; and the questions across cycles (hangs,
+//! rows bound by the command's values, livelocks, command storms). Prints the slowest plans of ≤ 10 rows
 //! (besides `otherwise`), then measures the slowest one with criterion.
 //!
 //! Run: `cargo bench -p rcs-dsl --bench analysis`
@@ -47,6 +48,11 @@ fn analyse(ir: &Ir, ci: usize, pi: usize) {
     let c = &ir.controllers[ci];
     let p = &c.plans[pi];
     let a = PlanAnalysis::new(ir, c, p);
+    // Across cycles: hangs, rows bound by entry values, loops, storms.
+    std::hint::black_box(a.hangs());
+    std::hint::black_box(a.entry_bound_rows());
+    std::hint::black_box(rcs_dsl::analysis::cycles::livelocks(c, p, &a));
+    std::hint::black_box(rcs_dsl::analysis::cycles::command_storms(c, p, &a));
     for r in 0..p.rows.len() {
         std::hint::black_box(a.never_matches(r));
         for s in 0..p.states.len() {

@@ -58,6 +58,11 @@ pub struct CommandStorm {
 
 /// The livelocks of one plan, each reachable from the entry.
 pub fn livelocks(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<Livelock> {
+    // No ring of states among the rows that can fire: nothing to walk.
+    let rings = state_cycles_of(plan, an);
+    if rings.is_empty() {
+        return Vec::new();
+    }
     let Some(walker) = Walker::new(ctrl, plan, an) else {
         return Vec::new();
     };
@@ -89,7 +94,7 @@ pub fn livelocks(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<Livel
         None => vec![1],
     };
     let mut found = Vec::new();
-    for cycle in state_cycles_of(plan, an) {
+    for cycle in rings {
         // Sending to a subordinate whose status the rows read changes what
         // they read (the handshake shows it EXECUTING): not constant.
         if cycle.iter().any(|(r, _)| {
@@ -166,7 +171,7 @@ pub fn livelocks(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<Livel
                     Some(v) => (*v == not_ready()) != at.sent.contains(x),
                 })
         };
-        let entry = walker.walk(params).into_iter().find(|at| {
+        let entry = walker.first(params, &|at| {
             at.state_cycles == 1 && cycle.iter().any(|(_, s)| *s == at.state) && consistent(at)
         });
         let Some(at) = entry else { continue };
@@ -188,8 +193,20 @@ pub fn livelocks(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<Livel
 /// The command storms of one plan: per row and subordinate, the first one
 /// a walk from the entry finds.
 pub fn command_storms(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<CommandStorm> {
+    // A row can send on two cycles in a row only if it leaves the plan in
+    // a state it covers (`same`, its own state, or any state for a `*`
+    // row) and is not an entry row: for the others no walk is needed.
     let candidates: Vec<usize> = (0..plan.rows.len())
-        .filter(|&i| sends(&plan.rows[i]).next().is_some())
+        .filter(|&i| {
+            let r = &plan.rows[i];
+            let stays = match r.to {
+                Target::Same => true,
+                Target::State(t) => covers(&r.from, t),
+                Target::Done | Target::Error(_) => false,
+            };
+            // An entry row fires only on the command's first cycle.
+            stays && !r.is_entry && sends(r).next().is_some()
+        })
         .collect();
     if candidates.is_empty() {
         return Vec::new();

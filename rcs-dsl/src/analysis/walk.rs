@@ -227,6 +227,26 @@ impl<'a, 'ir> Walker<'a, 'ir> {
 
     /// Every place walks from the entry reach, by cycle, a few per cycle.
     pub(super) fn walk(&self, pinned: Vec<(LeafId, Value)>) -> Vec<Place> {
+        self.walk_until(pinned, &|_| false).0
+    }
+
+    /// The first place of [`walk`](Self::walk)'s, in its order, that
+    /// `stop` accepts, without walking further than it.
+    pub(super) fn first(
+        &self,
+        pinned: Vec<(LeafId, Value)>,
+        stop: &dyn Fn(&Place) -> bool,
+    ) -> Option<Place> {
+        self.walk_until(pinned, stop).1
+    }
+
+    /// The places of a walk, layer by layer, up to the first that `stop`
+    /// accepts (returned beside them).
+    fn walk_until(
+        &self,
+        pinned: Vec<(LeafId, Value)>,
+        stop: &dyn Fn(&Place) -> bool,
+    ) -> (Vec<Place>, Option<Place>) {
         let mut layer = vec![Place {
             state: StateId::S0,
             state_cycles: 0,
@@ -235,6 +255,9 @@ impl<'a, 'ir> Walker<'a, 'ir> {
             sent: Vec::new(),
             path: Vec::new(),
         }];
+        if stop(&layer[0]) {
+            return (Vec::new(), layer.pop());
+        }
         let mut all = layer.clone();
         for _ in 0..self.depth() {
             let mut next: Vec<Place> = Vec::new();
@@ -254,6 +277,9 @@ impl<'a, 'ir> Walker<'a, 'ir> {
                             && p.path.last().map(|s| s.row) == Some(row)
                     };
                     if !next.iter().any(same) {
+                        if stop(&to) {
+                            return (all, Some(to));
+                        }
                         next.push(to);
                     }
                 }
@@ -261,7 +287,7 @@ impl<'a, 'ir> Walker<'a, 'ir> {
             all.extend(next.iter().cloned());
             layer = next;
         }
-        all
+        (all, None)
     }
 
     /// How many cycles walks take: enough to visit every state and to wait

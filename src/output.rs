@@ -1,0 +1,122 @@
+//! What the subcommands print and how they end: diagnostics and their
+//! summary, cargo-like status lines, writing to a file or stdout, and
+//! exit statuses.
+
+use crate::args::*;
+use rcs_dsl::render::{self, Format};
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// A failure outside the plans: exit 2 with one line.
+pub(crate) fn fail(reason: impl std::fmt::Display) -> ExitCode {
+    eprintln!("error: {reason}");
+    ExitCode::from(2)
+}
+
+pub(crate) fn default_paths(paths: Vec<PathBuf>) -> Vec<PathBuf> {
+    if paths.is_empty() {
+        vec![PathBuf::from(".")]
+    } else {
+        paths
+    }
+}
+
+/// Diagnostics printed so far.
+#[derive(Default)]
+pub(crate) struct Counts {
+    pub(crate) errors: usize,
+    pub(crate) warnings: usize,
+}
+
+/// Print one plan set's diagnostics (warnings only when not quiet). JSON
+/// goes to stdout unless `stdout_busy` (the command prints its product there).
+pub(crate) fn print_diagnostics(
+    set: &rcs_dsl::PlanSet,
+    checked: &rcs_dsl::Checked,
+    common: &Common,
+    stdout_busy: bool,
+    counts: &mut Counts,
+) {
+    let format = common.format();
+    let mut out = std::io::stdout().lock();
+    let mut err = std::io::stderr().lock();
+    for d in &checked.diagnostics {
+        if d.severity == rcs_dsl::Severity::Error {
+            counts.errors += 1;
+        } else {
+            counts.warnings += 1;
+            if common.quiet {
+                continue;
+            }
+        }
+        let text = render::render(d, &set.sources, format);
+        // Machine formats go to stdout; human text to stderr, as rustc does.
+        let _ = match format {
+            Format::Json if !stdout_busy => out.write_all(text.as_bytes()),
+            _ => err.write_all(text.as_bytes()),
+        };
+    }
+}
+
+/// The `N errors, M warnings` line after the diagnostics.
+pub(crate) fn print_summary(common: &Common, counts: &Counts) {
+    if common.format() != Format::Json && !common.quiet {
+        if let Some(s) = render::summary(counts.errors, counts.warnings) {
+            eprintln!("{s}");
+        }
+    }
+}
+
+/// cargo-style progress lines on stderr: a right-aligned verb (bold green
+/// with colour), then the message. Silent with `--quiet`.
+pub(crate) struct Status {
+    pub(crate) color: bool,
+    pub(crate) quiet: bool,
+}
+
+impl Status {
+    pub(crate) fn line(&self, verb: &str, message: impl std::fmt::Display) {
+        if self.quiet {
+            return;
+        }
+        if self.color {
+            let pad = " ".repeat(12usize.saturating_sub(verb.chars().count()));
+            eprintln!("{pad}\x1b[1m\x1b[32m{verb}\x1b[0m {message}");
+        } else {
+            eprintln!("{verb:>12} {message}");
+        }
+    }
+}
+
+pub(crate) fn plural(n: usize, word: &str) -> String {
+    format!("{n} {word}{}", if n == 1 { "" } else { "s" })
+}
+
+/// The name a plan set goes by before it is checked.
+pub(crate) fn set_name(set: &rcs_dsl::PlanSet) -> &str {
+    set.manifest
+        .system
+        .as_ref()
+        .map_or(set.name.as_str(), |(s, _)| s.as_str())
+}
+
+/// Write a command's product to `out` (a file) or to stdout.
+pub(crate) fn emit(out: Option<&std::path::Path>, bytes: &[u8]) -> ExitCode {
+    let result = match out {
+        Some(path) => std::fs::write(path, bytes)
+            .map_err(|e| format!("cannot write {}: {e}", rcs_dsl::load::display(path))),
+        None => {
+            let mut stdout = std::io::stdout().lock();
+            match stdout.write_all(bytes).and_then(|()| stdout.flush()) {
+                // A closed pipe (`rcsc ir | head`) is the reader's choice, not a failure.
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+                r => r.map_err(|e| format!("cannot write to stdout: {e}")),
+            }
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(reason) => fail(reason),
+    }
+}

@@ -66,6 +66,14 @@ pub trait Controller: Any + Send {
     fn bookkeeping(&self) -> Option<&Bookkeeping> {
         None
     }
+
+    /// Each subordinate's name with the cycles in which it answered with an
+    /// older serial than the last command sent
+    /// ([`SubordinateLink::old_echoes`](crate::SubordinateLink::old_echoes)),
+    /// given to `f` one by one. For the timing report, not the cycle path.
+    fn old_echoes(&self, f: &mut dyn FnMut(&str, u64)) {
+        let _ = f;
+    }
 }
 
 /// How the executive waits for the next deadline.
@@ -545,6 +553,16 @@ impl Executive {
     pub fn controller_stats(&self, name: &str) -> Option<&ControllerStats> {
         self.slots.iter().find(|s| s.name == name).map(|s| &s.stats)
     }
+    /// Per subordinate of controller `name`, the cycles in which it echoed
+    /// an older serial than the last command sent (empty for a controller
+    /// without subordinates, or one not on this executive).
+    pub fn old_echoes(&self, name: &str) -> Vec<(String, u64)> {
+        let mut out = Vec::new();
+        if let Some(c) = self.controller(name) {
+            c.old_echoes(&mut |sub, n| out.push((sub.to_string(), n)));
+        }
+        out
+    }
     /// Controller `name` itself (e.g. to inspect its bookkeeping).
     pub fn controller(&self, name: &str) -> Option<&dyn Controller> {
         self.slots
@@ -569,6 +587,40 @@ impl Executive {
 
 #[cfg(test)]
 mod tests {
+    /// A supervisor with one subordinate that keeps echoing an old serial.
+    struct Stuck {
+        link: crate::SubordinateLink,
+    }
+
+    impl Controller for Stuck {
+        fn name(&self) -> &str {
+            "SUP"
+        }
+        fn cycle(&mut self, ctx: &CycleContext) {
+            let read = crate::gm::Stamped {
+                value: crate::StatusBuffer::default(),
+                generation: ctx.cycle + 1,
+                writer_cycle: ctx.cycle,
+            };
+            self.link.observe(&read);
+        }
+        fn old_echoes(&self, f: &mut dyn FnMut(&str, u64)) {
+            f("SUB", self.link.old_echoes());
+        }
+    }
+
+    #[test]
+    fn the_timing_report_gives_each_subordinates_old_echoes() -> Result<(), SetupError> {
+        let mut link = crate::SubordinateLink::new();
+        link.next_command();
+        let mut e = Executive::new(ExecutiveConfig::new("cpu", Duration::from_millis(1)))?;
+        e.add(Box::new(Stuck { link }))?;
+        e.run_cycles(5);
+        assert_eq!(e.old_echoes("SUP"), vec![("SUB".to_string(), 5)]);
+        assert!(e.old_echoes("NOBODY").is_empty());
+        Ok(())
+    }
+
     #[test]
     fn a_period_past_the_bound_is_refused_at_construction() {
         let e = Executive::new(ExecutiveConfig::new("cpu", Duration::MAX));

@@ -66,6 +66,14 @@ fn a_system_gives_typed_controllers_while_it_holds_their_executive() {
     system.pr_mut().expect("PR").hooks_mut().asked = 10;
     assert_eq!(system.pr().map(|pr| pr.hooks().asked), Some(10));
 
+    // The timing report names each supervisor's subordinates with their
+    // stale echoes: none here, as each subordinate runs after its
+    // supervisor in the same heartbeat and answers at once.
+    let exec = &system.executives[0];
+    assert_eq!(exec.old_echoes("SM"), vec![("PR".to_string(), 0)]);
+    assert_eq!(exec.old_echoes("PR"), vec![("TB".to_string(), 0)]);
+    assert!(exec.old_echoes("TB").is_empty());
+
     // Out of the system (to run on a thread), an executive's controllers
     // are not reachable; back in, they are.
     let executives = std::mem::take(&mut system.executives);

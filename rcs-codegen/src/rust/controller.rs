@@ -364,6 +364,16 @@ pub(crate) fn module(
             quote!(Command::#v { #(#binds,)* .. } => self.#func(#subs_arg #sep #(#locals),*))
         })
     });
+    // The timing report's count of stale echoes, per subordinate.
+    let old_echoes = if sub_handles.is_empty() {
+        quote!()
+    } else {
+        quote! {
+            fn old_echoes(&self, f: &mut dyn FnMut(&str, u64)) {
+                #(f(#sub_names, self.#sub_handles.link().old_echoes());)*
+            }
+        }
+    };
     let any_subs = c.plans.iter().any(uses_subs);
     let subs_param = if any_subs {
         quote!(subs)
@@ -597,6 +607,8 @@ pub(crate) fn module(
                 }
 
                 fn bookkeeping(&self) -> Option<&rt::Bookkeeping> { Some(&self.bk) }
+
+                #old_echoes
             }
 
             #extra

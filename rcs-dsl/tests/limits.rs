@@ -32,3 +32,24 @@ fn rows(n: usize) -> String {
 fn one_row_too_many_is_refused_alone() {
     assert_eq!(codes(&rows(65_536)), ["too_large"]);
 }
+
+/// Hostile sizes go through the front end in O(n log n): a file declaring
+/// 300,000 statuses, and a plan of 100,000 rows naming 100,000 states, are
+/// refused as `too_large` (a name looked up linearly per declaration would
+/// take hours here, which CI's time limit would show).
+#[test]
+fn huge_declarations_are_refused_without_quadratic_lookups() {
+    let list: Vec<String> = (0..300_000).map(|i| format!("S{i}")).collect();
+    let statuses = format!(
+        "controller Big {{\n    command GO\n    status {}\n    plan GO {{ *0 when new_command -> Done }}\n}}\n",
+        list.join(", ")
+    );
+    assert_eq!(codes(&statuses), ["too_large"]);
+    let mut states =
+        String::from("buffer In { a: bool }\ncontroller Big {\n    reads i: In\n    command GO\n    plan GO {\n        *0 when new_command -> S1\n");
+    for k in 1..100_000 {
+        states.push_str(&format!("        S{k} when i.a -> S{}\n", k + 1));
+    }
+    states.push_str("    }\n}\n");
+    assert_eq!(codes(&states), ["too_large"]);
+}

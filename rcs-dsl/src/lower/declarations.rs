@@ -3,7 +3,7 @@
 //! var initialisers and lowers the plans (through `lower::plans`).
 
 use super::expr::Cx;
-use super::{duplicate, resolve_type, Globals};
+use super::{duplicate, resolve_type, ByName, Globals};
 use crate::ast;
 use crate::diagnostic::{Code, Diagnostic, Diagnostics};
 use crate::ir::*;
@@ -15,27 +15,33 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
         let mut commands: Vec<Command> = Vec::new();
         let mut statuses = std::mem::take(&mut ir.controllers[i].statuses);
         let mut errors: Vec<ErrorDef> = Vec::new();
+        let (mut command_names, mut error_names) = (ByName::default(), ByName::default());
+        let mut status_names = ByName::default();
+        for (k, st) in statuses.iter().enumerate() {
+            status_names.first_or_insert(&st.name, k);
+        }
         let mut vars: Vec<Var> = Vec::new();
         let mut hooks: Vec<Hook> = Vec::new();
         // One value namespace: vars, hooks, buffers and subordinates.
         let mut values: Vec<(String, Span)> = Vec::new();
+        let mut value_names = ByName::default();
+        // A name given twice keeps its first place (the buffer and
+        // subordinate checks report the second).
+        let mut first_value = |n: &ast::Name| {
+            if value_names.first_or_insert(&n.text, values.len()).is_none() {
+                values.push((n.text.to_string(), n.span));
+            }
+        };
         for e in &c.entries {
             match &e.kind {
-                ast::EntryKind::Reads(n, _) | ast::EntryKind::Writes(n, _) => {
-                    values.push((n.text.to_string(), n.span))
-                }
-                ast::EntryKind::Subordinates(ns) => {
-                    for n in ns {
-                        if !values.iter().any(|(v, _)| *v == n.text) {
-                            values.push((n.text.to_string(), n.span));
-                        }
-                    }
-                }
+                ast::EntryKind::Reads(n, _) | ast::EntryKind::Writes(n, _) => first_value(n),
+                ast::EntryKind::Subordinates(ns) => ns.iter().for_each(&mut first_value),
                 _ => {}
             }
         }
         let mut claim = |name: &ast::Name, what: &str, diags: &mut Diagnostics| -> bool {
-            if let Some((_, first)) = values.iter().find(|(v, _)| *v == name.text) {
+            let found = value_names.first_or_insert(&name.text, values.len());
+            if let Some((_, first)) = found.map(|k| &values[k]) {
                 // `reads`, `writes` and `subordinates` were collected first;
                 // the diagnostic goes on whichever declaration comes later.
                 let (later, earlier) = if first.start > name.span.start {
@@ -54,8 +60,9 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
             let docs = &e.outer.docs;
             match &e.kind {
                 ast::EntryKind::Command(name, params) => {
-                    if let Some(first) = commands.iter().find(|x| x.name == name.text) {
-                        diags.push(duplicate("command", &name.text, name.span, first.span));
+                    if let Some(first) = command_names.first_or_insert(&name.text, commands.len()) {
+                        let first = commands[first].span;
+                        diags.push(duplicate("command", &name.text, name.span, first));
                         continue;
                     }
                     commands.push(Command {
@@ -68,7 +75,10 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                 }
                 ast::EntryKind::Status(names) => {
                     for name in names {
-                        if let Some(first) = statuses.iter().find(|x| x.name == name.text) {
+                        if let Some(first) = status_names
+                            .first_or_insert(&name.text, statuses.len())
+                            .map(|k| &statuses[k])
+                        {
                             match first.span {
                                 Some(f) => diags.push(duplicate("status", &name.text, name.span, f)),
                                 None => diags.push(
@@ -92,8 +102,9 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                 }
                 ast::EntryKind::Error(names) => {
                     for name in names {
-                        if let Some(first) = errors.iter().find(|x| x.name == name.text) {
-                            diags.push(duplicate("error code", &name.text, name.span, first.span));
+                        if let Some(first) = error_names.first_or_insert(&name.text, errors.len()) {
+                            let first = errors[first].span;
+                            diags.push(duplicate("error code", &name.text, name.span, first));
                             continue;
                         }
                         errors.push(ErrorDef {
@@ -148,14 +159,11 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
 
 fn lower_params(g: &Globals, params: &[ast::Param], diags: &mut Diagnostics) -> Vec<Param> {
     let mut out: Vec<Param> = Vec::new();
+    let mut names = ByName::default();
     for p in params {
-        if let Some(first) = out.iter().find(|x| x.name == p.name.text) {
-            diags.push(duplicate(
-                "parameter",
-                &p.name.text,
-                p.name.span,
-                first.span,
-            ));
+        if let Some(first) = names.first_or_insert(&p.name.text, out.len()) {
+            let first = out[first].span;
+            diags.push(duplicate("parameter", &p.name.text, p.name.span, first));
             continue;
         }
         let ty = resolve_type(g, &p.ty, diags).unwrap_or(Type::Unit);

@@ -86,6 +86,23 @@ pub fn lower(
     }
 }
 
+/// Where each name of one scope was first declared, so that finding a name
+/// stays O(log n) however many a file declares (a hostile one may declare
+/// a million: a linear search per declaration would take hours).
+#[derive(Default)]
+pub(super) struct ByName(BTreeMap<String, usize>);
+
+impl ByName {
+    /// The index `name` was first declared at; else remember `index` for it.
+    pub(super) fn first_or_insert(&mut self, name: &str, index: usize) -> Option<usize> {
+        if let Some(&i) = self.0.get(name) {
+            return Some(i);
+        }
+        self.0.insert(name.to_string(), index);
+        None
+    }
+}
+
 fn duplicate(what: &str, name: &str, span: Span, first: Span) -> Diagnostic {
     Diagnostic::error(
         Code::DuplicateDefinition,
@@ -145,9 +162,10 @@ fn collect_items<'a>(files: &'a [ast::File], diags: &mut Diagnostics) -> Globals
 fn lower_enums(g: &Globals, ir: &mut Ir, diags: &mut Diagnostics) {
     for e in &g.enums {
         let mut variants: Vec<Variant> = Vec::new();
+        let mut names = ByName::default();
         for (docs, v) in &e.variants {
-            if let Some(first) = variants.iter().find(|x| x.name == v.text) {
-                diags.push(duplicate("variant", &v.text, v.span, first.span));
+            if let Some(first) = names.first_or_insert(&v.text, variants.len()) {
+                diags.push(duplicate("variant", &v.text, v.span, variants[first].span));
                 continue;
             }
             variants.push(Variant {
@@ -257,9 +275,11 @@ pub(crate) fn primitive(name: &str) -> Option<Type> {
 fn lower_buffer_types(g: &Globals, ir: &mut Ir, diags: &mut Diagnostics) {
     for b in &g.buffers {
         let mut fields: Vec<FieldDef> = Vec::new();
+        let mut names = ByName::default();
         for f in &b.fields {
-            if let Some(first) = fields.iter().find(|x| x.name == f.name.text) {
-                diags.push(duplicate("field", &f.name.text, f.name.span, first.span));
+            if let Some(first) = names.first_or_insert(&f.name.text, fields.len()) {
+                let first = fields[first].span;
+                diags.push(duplicate("field", &f.name.text, f.name.span, first));
                 continue;
             }
             // An unresolved field type is reported; the field is kept (as

@@ -20,9 +20,11 @@ impl Cx<'_, '_> {
             name: "S0".to_string(),
             span: None,
         }];
+        let mut names = ByName::default();
+        names.first_or_insert("S0", 0);
         let mut rows = Vec::new();
         for (pos, r) in p.rows.iter().enumerate() {
-            if let Some(row) = self.row(r, pos as u32, &mut states) {
+            if let Some(row) = self.row(r, pos as u32, (&mut states, &mut names)) {
                 rows.push(row);
             }
         }
@@ -46,10 +48,10 @@ impl Cx<'_, '_> {
         &mut self,
         r: &ast::Row,
         position: u32,
-        states: &mut Vec<State>,
+        (states, names): (&mut Vec<State>, &mut ByName),
     ) -> Option<Row> {
-        let intern = |states: &mut Vec<State>, n: &ast::Name| -> StateId {
-            match states.iter().position(|s| s.name == n.text) {
+        let mut intern = |states: &mut Vec<State>, n: &ast::Name| -> StateId {
+            match names.first_or_insert(&n.text, states.len()) {
                 Some(i) => {
                     if states[i].span.is_none() {
                         states[i].span = Some(n.span);

@@ -53,3 +53,19 @@ fn huge_declarations_are_refused_without_quadratic_lookups() {
     states.push_str("    }\n}\n");
     assert_eq!(codes(&states), ["too_large"]);
 }
+
+/// References are looked up through the index too: 60,000 statuses, each
+/// reported by one job of one row, check in O(n log n) (a linear search
+/// per reference would be 3.6 billion comparisons).
+#[test]
+fn many_references_are_looked_up_by_name() {
+    let n = 60_000;
+    let list: Vec<String> = (0..n).map(|i| format!("S{i}")).collect();
+    let jobs: Vec<String> = (0..n).map(|i| format!("report S{i}")).collect();
+    let text = format!(
+        "controller Big {{\n    command GO\n    status {}\n    plan GO {{ *0 when new_command -> Done {{ {} }} }}\n}}\n",
+        list.join(", "),
+        jobs.join("; ")
+    );
+    assert!(codes(&text).is_empty(), "{:?}", codes(&text));
+}

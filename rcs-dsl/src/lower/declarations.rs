@@ -3,6 +3,7 @@
 //! var initialisers and lowers the plans (through `lower::plans`).
 
 use super::expr::Cx;
+use super::index::find;
 use super::{duplicate, resolve_type, ByName, Globals};
 use crate::ast;
 use crate::diagnostic::{Code, Diagnostic, Diagnostics};
@@ -180,6 +181,7 @@ fn lower_params(g: &Globals, params: &[ast::Param], diags: &mut Diagnostics) -> 
 /// Pass 2 for one controller: var initialisers and plans.
 pub(super) fn lower_controller_body(
     g: &Globals,
+    names: &super::index::Index,
     ir: &mut Ir,
     id: CtrlId,
     c: &ast::ControllerDef,
@@ -205,6 +207,7 @@ pub(super) fn lower_controller_body(
             .collect();
         let mut cx = Cx {
             g,
+            ix: names,
             ir,
             ctrl: id,
             c: ctrl,
@@ -237,7 +240,8 @@ pub(super) fn lower_controller_body(
                     inits.push((vi, e));
                 }
                 ast::EntryKind::Plan(p) => {
-                    let Some(cmd) = ctrl.commands.iter().position(|x| x.name == p.verb.text) else {
+                    let Some(cmd) = find(&names.controllers[id.index()].commands, &p.verb.text)
+                    else {
                         cx.diags.push(
                             Diagnostic::error(
                                 Code::UnknownCommand,

@@ -9,6 +9,7 @@
 
 mod declarations;
 mod expr;
+mod index;
 mod plans;
 pub use expr::type_name;
 
@@ -66,8 +67,10 @@ pub fn lower(
     check_buffer_recursion(&ir, diags);
     let ctrl_asts = lower_controller_headers(&globals, &mut ir, sources, diags);
     check_hierarchy_cycles(&ir, diags);
+    let names = index::Index::new(&ir);
     for (i, c) in ctrl_asts.iter().enumerate() {
-        declarations::lower_controller_body(&globals, &mut ir, CtrlId(i as u32), c, diags);
+        let id = CtrlId(i as u32);
+        declarations::lower_controller_body(&globals, &names, &mut ir, id, c, diags);
     }
     ir.schedule = lower_schedule(&ir, manifest, diags);
     for c in &mut ir.controllers {
@@ -387,9 +390,12 @@ fn lower_controller_headers<'a>(
     // Where each controller was named as a subordinate, for multiple_supervisors.
     let mut supervised_at: Vec<Option<Span>> = vec![None; g.controllers.len()];
     let mut buffer_decl: Vec<(Span, Option<Span>)> = Vec::new(); // (first decl, writer decl)
+    let mut buffer_names = ByName::default();
     for (i, c) in g.controllers.iter().enumerate() {
         let id = CtrlId(i as u32);
         let mut level_seen: Option<Span> = None;
+        // The buffers this controller declared so far (`reads` or `writes`).
+        let mut own_buffers: std::collections::BTreeSet<BufferId> = Default::default();
         for e in &c.entries {
             match &e.kind {
                 ast::EntryKind::Level(n, _) => {
@@ -508,7 +514,7 @@ fn lower_controller_headers<'a>(
                         None => None,
                     };
                     let Some(bty) = bty else { continue };
-                    let existing = ir.buffers.iter().position(|b| b.name == name.text);
+                    let existing = buffer_names.first_or_insert(&name.text, ir.buffers.len());
                     let bid = match existing {
                         Some(b) if ir.buffers[b].ty == bty => BufferId(b as u32),
                         found => {
@@ -545,7 +551,7 @@ fn lower_controller_headers<'a>(
                         }
                     };
                     let ctrl = &mut ir.controllers[i];
-                    if ctrl.reads.contains(&bid) || ctrl.writes.contains(&bid) {
+                    if !own_buffers.insert(bid) {
                         // This controller's own earlier declaration.
                         let first = ctrl
                             .buffer_spans

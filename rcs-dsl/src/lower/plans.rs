@@ -3,6 +3,7 @@
 //! expression checker of `lower::expr`.
 
 use super::expr::{Cx, Value};
+use super::index::find;
 use super::*;
 use crate::ast::{self, AssignOp, BinOp};
 use crate::diagnostic::{Code, Diagnostic};
@@ -100,26 +101,24 @@ impl Cx<'_, '_> {
         let to = match &r.target {
             ast::Target::Same(_) => Target::Same,
             ast::Target::Error(None, _) => Target::Error(None),
-            ast::Target::Error(Some(code), _) => {
-                match self.c.errors.iter().position(|e| e.name == code.text) {
-                    Some(i) => Target::Error(Some(ErrorId(i as u32))),
-                    None => {
-                        self.diags.push(
-                            Diagnostic::error(
-                                Code::UnknownName,
-                                format!(
-                                    "controller `{}` has no error code `{}`",
-                                    self.c.name, code.text
-                                ),
-                                code.span,
-                                "not declared",
-                            )
-                            .with_help(format!("declare it: `error {}`", code.text)),
-                        );
-                        Target::Error(None)
-                    }
+            ast::Target::Error(Some(code), _) => match find(&self.names().errors, &code.text) {
+                Some(i) => Target::Error(Some(ErrorId(i as u32))),
+                None => {
+                    self.diags.push(
+                        Diagnostic::error(
+                            Code::UnknownName,
+                            format!(
+                                "controller `{}` has no error code `{}`",
+                                self.c.name, code.text
+                            ),
+                            code.span,
+                            "not declared",
+                        )
+                        .with_help(format!("declare it: `error {}`", code.text)),
+                    );
+                    Target::Error(None)
                 }
-            }
+            },
             ast::Target::State(n) if n.text == "Done" => Target::Done,
             ast::Target::State(n) => Target::State(intern(states, n)),
         };
@@ -144,49 +143,44 @@ impl Cx<'_, '_> {
 
     pub(in crate::lower) fn job(&mut self, j: &ast::Job) -> Option<Job> {
         match j {
-            ast::Job::Report(name, span) => {
-                match self.c.statuses.iter().position(|s| s.name == name.text) {
-                    Some(i) if i >= 4 => Some(Job::Report {
-                        status: StatusId(i as u32),
-                        span: *span,
-                    }),
-                    Some(_) => {
-                        let target = match name.text.as_str() {
-                            "DONE" => "end the row with `-> Done`",
-                            "ERROR" => "end the row with `-> Error(CODE)`",
-                            _ => "the runtime sets it; report a custom status instead",
-                        };
-                        self.diags.push(
-                            Diagnostic::error(
-                                Code::UnknownName,
-                                format!(
-                                    "`report` takes a custom status, and `{}` is built in",
-                                    name.text
-                                ),
-                                name.span,
-                                "built-in status",
-                            )
-                            .with_help(target.to_string()),
-                        );
-                        None
-                    }
-                    None => {
-                        self.diags.push(
-                            Diagnostic::error(
-                                Code::UnknownName,
-                                format!(
-                                    "controller `{}` has no status `{}`",
-                                    self.c.name, name.text
-                                ),
-                                name.span,
-                                "not declared",
-                            )
-                            .with_help(format!("declare it: `status {}`", name.text)),
-                        );
-                        None
-                    }
+            ast::Job::Report(name, span) => match find(&self.names().statuses, &name.text) {
+                Some(i) if i >= 4 => Some(Job::Report {
+                    status: StatusId(i as u32),
+                    span: *span,
+                }),
+                Some(_) => {
+                    let target = match name.text.as_str() {
+                        "DONE" => "end the row with `-> Done`",
+                        "ERROR" => "end the row with `-> Error(CODE)`",
+                        _ => "the runtime sets it; report a custom status instead",
+                    };
+                    self.diags.push(
+                        Diagnostic::error(
+                            Code::UnknownName,
+                            format!(
+                                "`report` takes a custom status, and `{}` is built in",
+                                name.text
+                            ),
+                            name.span,
+                            "built-in status",
+                        )
+                        .with_help(target.to_string()),
+                    );
+                    None
                 }
-            }
+                None => {
+                    self.diags.push(
+                        Diagnostic::error(
+                            Code::UnknownName,
+                            format!("controller `{}` has no status `{}`", self.c.name, name.text),
+                            name.span,
+                            "not declared",
+                        )
+                        .with_help(format!("declare it: `status {}`", name.text)),
+                    );
+                    None
+                }
+            },
             ast::Job::Call(e) => {
                 let (x, _) = self.infer(e, None);
                 Some(Job::Call(x))
@@ -273,7 +267,7 @@ impl Cx<'_, '_> {
             }
         };
         let target = &self.ir.controllers[sid.index()];
-        let Some(ci) = target.commands.iter().position(|c| c.name == verb.text) else {
+        let Some(ci) = find(&self.ix.controllers[sid.index()].commands, &verb.text) else {
             self.diags.push(
                 Diagnostic::error(
                     Code::UnknownCommand,
@@ -300,7 +294,7 @@ impl Cx<'_, '_> {
         let mut seen: Vec<Option<Span>> = vec![None; command.params.len()];
         let mut ok = true;
         for (n, a) in args {
-            match command.params.iter().position(|p| p.name == n.text) {
+            match find(&self.ix.controllers[sid.index()].params[ci], &n.text) {
                 None => {
                     self.diags.push(
                         Diagnostic::error(
@@ -435,7 +429,7 @@ impl Cx<'_, '_> {
                 match &p.ty {
                     Type::Buffer(bid) => {
                         let bty = &self.ir.buffer_types[bid.index()];
-                        match bty.fields.iter().position(|x| x.name == f.text) {
+                        match find(&self.ix.fields[bid.index()], &f.text) {
                             Some(fi) => {
                                 p.ty = bty.fields[fi].ty.clone();
                                 if p.ty == Type::Unit {

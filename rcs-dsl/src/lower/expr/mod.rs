@@ -9,6 +9,8 @@
 mod names;
 mod operators;
 
+use super::index::{find, ControllerNames, Index};
+
 use super::{primitive, Globals, ItemRef};
 use crate::ast::{self, BinOp, UnOp};
 use crate::diagnostic::{Code, Diagnostic, Diagnostics};
@@ -39,6 +41,8 @@ pub(in crate::lower) struct Cx<'a, 'g> {
     pub(in crate::lower) g: &'a Globals<'g>,
     pub(in crate::lower) ir: &'a Ir,
     pub(in crate::lower) ctrl: CtrlId,
+    /// Every declared name, indexed.
+    pub(in crate::lower) ix: &'a Index,
     pub(in crate::lower) c: &'a Controller,
     pub(in crate::lower) plan_cmd: Option<CommandId>,
     /// In a var initialiser: only constants are allowed.
@@ -76,34 +80,12 @@ impl Cx<'_, '_> {
     }
 
     pub(in crate::lower) fn value(&self, name: &str) -> Option<Value> {
-        let c = self.c;
-        if let Some(i) = c.vars.iter().position(|v| v.name == name) {
-            return Some(Value::Var(VarId(i as u32)));
-        }
-        if let Some(b) = c
-            .writes
-            .iter()
-            .find(|b| self.ir.buffers[b.index()].name == name)
-        {
-            return Some(Value::Buffer(*b, true));
-        }
-        if let Some(b) = c
-            .reads
-            .iter()
-            .find(|b| self.ir.buffers[b.index()].name == name)
-        {
-            return Some(Value::Buffer(*b, false));
-        }
-        if let Some(i) = c.hooks.iter().position(|h| h.name == name) {
-            return Some(Value::Hook(HookId(i as u32)));
-        }
-        if c.subordinates
-            .iter()
-            .any(|s| self.ir.controllers[s.index()].name == name)
-        {
-            return Some(Value::Sub);
-        }
-        None
+        self.names().values.get(name).copied()
+    }
+
+    /// This controller's names, indexed.
+    pub(in crate::lower) fn names(&self) -> &ControllerNames {
+        &self.ix.controllers[self.ctrl.index()]
     }
 
     pub(in crate::lower) fn not_const(&mut self, span: Span, what: &str) -> (Expr, Ty) {
@@ -262,7 +244,7 @@ impl Cx<'_, '_> {
                     return self.not_const(span, "a command parameter");
                 };
                 let command = &self.c.commands[cmd.index()];
-                match command.params.iter().position(|x| x.name == p.text) {
+                match find(&self.names().params[cmd.index()], &p.text) {
                     Some(pi) => {
                         let ty = command.params[pi].ty.clone();
                         if ty == Type::Unit {

@@ -69,3 +69,21 @@ fn many_references_are_looked_up_by_name() {
     );
     assert!(codes(&text).is_empty(), "{:?}", codes(&text));
 }
+
+/// A plan far past the rule of ten but within the runtime's limits (30,000
+/// rows and states) is checked in linear time: the analysis of conditions
+/// leaves plans of more than `MAX_ANALYSED` rows or states alone (its cost
+/// grows as rows² × states), and the plan graph is built from the rows'
+/// state patterns. Only `rule_of_ten` speaks.
+#[test]
+fn a_huge_plan_is_checked_without_its_analysis() {
+    let mut text = String::from(
+        "buffer In { a: bool }\ncontroller Big {\n    reads i: In\n    command GO\n    plan GO {\n        *0 when new_command -> S1\n        *1 when !i.a && i.a -> Error\n",
+    );
+    let n = 30_000;
+    for k in 1..n {
+        text.push_str(&format!("        S{k} when i.a -> S{}\n", k + 1));
+    }
+    text.push_str(&format!("        S{n} when i.a -> Done\n    }}\n}}\n"));
+    assert_eq!(codes(&text), ["rule_of_ten"]);
+}

@@ -163,6 +163,9 @@ impl PlanAnalysis<'_> {
     /// `S0` "any cycle" includes the first, so a row back to `S0`, whose
     /// entry rows need a new command, is still reported.
     pub fn hangs(&self) -> Vec<Hang> {
+        if !self.analysed() {
+            return Vec::new();
+        }
         let constants = self.constant_vars();
         let n = self.plan.states.len();
         // The usual plan has, in each state, a row that does not depend on
@@ -223,6 +226,9 @@ impl PlanAnalysis<'_> {
     /// condition but not with any case the state may be reached with.
     /// Only the command's parameters are pinned (every answer a proof).
     pub fn entry_bound_rows(&self) -> Vec<EntryBound> {
+        if !self.analysed() {
+            return Vec::new();
+        }
         let params = self.command_leaves();
         // Only a row that compares a parameter exactly can be made false
         // by the values its state is entered with (for a proof, an opaque

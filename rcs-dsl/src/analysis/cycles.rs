@@ -58,6 +58,9 @@ pub struct CommandStorm {
 
 /// The livelocks of one plan, each reachable from the entry.
 pub fn livelocks(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<Livelock> {
+    if !an.analysed() {
+        return Vec::new();
+    }
     // No ring of states among the rows that can fire: nothing to walk.
     let rings = state_cycles_of(plan, an);
     if rings.is_empty() {
@@ -193,6 +196,9 @@ pub fn livelocks(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<Livel
 /// The command storms of one plan: per row and subordinate, the first one
 /// a walk from the entry finds.
 pub fn command_storms(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<CommandStorm> {
+    if !an.analysed() {
+        return Vec::new();
+    }
     // A row can send on two cycles in a row only if it leaves the plan in
     // a state it covers (`same`, its own state, or any state for a `*`
     // row) and is not an entry row: for the others no walk is needed.

@@ -61,6 +61,12 @@ use search::{Mode, Outcome, Search};
 use std::sync::Arc;
 use terms::{Formula, Leaf, LeafId, Terms};
 
+/// The most rows, or states, of a plan the analysis takes on. Its cost
+/// grows as rows² × states; past this (a generated or hostile plan, far
+/// beyond the rule of ten) it answers "unknown" and the checks say
+/// nothing, rather than take minutes.
+pub const MAX_ANALYSED: usize = 256;
+
 /// The answer to "can this happen?".
 #[derive(Clone, Debug)]
 pub enum Answer {
@@ -114,6 +120,9 @@ pub struct PlanAnalysis<'ir> {
     /// Per leaf, the values a witness search tries (made on first use).
     candidates: std::cell::OnceCell<Vec<Vec<Value>>>,
     new_command: LeafId,
+    /// The plan is larger than [`MAX_ANALYSED`]: every question is
+    /// answered "unknown" at once (the checks then say nothing).
+    skipped: bool,
     /// Proofs asked before, by question: the checks ask some twice.
     proved: std::cell::RefCell<std::collections::BTreeMap<Question, bool>>,
 }
@@ -153,8 +162,15 @@ impl<'ir> PlanAnalysis<'ir> {
             tables,
             candidates: std::cell::OnceCell::new(),
             new_command,
+            skipped: plan.rows.len() > MAX_ANALYSED || plan.states.len() > MAX_ANALYSED,
             proved: Default::default(),
         }
+    }
+
+    /// Whether the analysis answers questions about this plan: plans of
+    /// more than [`MAX_ANALYSED`] rows or states are left alone.
+    pub fn analysed(&self) -> bool {
+        !self.skipped
     }
 
     /// Whether row `row` can match at all, judged by its own `from` and
@@ -186,6 +202,9 @@ impl<'ir> PlanAnalysis<'ir> {
     /// `None` when some row may match (or the analysis cannot tell, or no
     /// condition reads `sub`'s status).
     pub fn stalls_in(&self, state: StateId, sub: CtrlId, status: StatusId) -> Option<Witness> {
+        if self.skipped {
+            return None;
+        }
         let leaf = self.terms.find(&Leaf::SubStatus(sub))?;
         let mut any = Vec::new();
         for (i, row) in self.plan.rows.iter().enumerate() {
@@ -360,6 +379,9 @@ impl<'ir> PlanAnalysis<'ir> {
                 return true;
             }
         }
+        if self.skipped {
+            return false;
+        }
         if let Some(&never) = self.proved.borrow().get(&q) {
             return never;
         }
@@ -440,6 +462,9 @@ impl<'ir> PlanAnalysis<'ir> {
     }
 
     fn prove(&self, f: &Formula, fixed: &[(LeafId, Value)]) -> Outcome {
+        if self.skipped {
+            return Outcome::Unknown;
+        }
         Search::new(&self.terms, Mode::Prove, &self.cells, &self.tables, fixed).run(f)
     }
 

@@ -33,6 +33,9 @@ pub(crate) struct Analysis {
 }
 
 pub(crate) fn analyse(p: &Plan, conditions: &PlanAnalysis) -> Analysis {
+    if !conditions.analysed() {
+        return structural(p);
+    }
     let n = p.states.len();
     let mut g: DiGraph<(), ()> = DiGraph::with_capacity(n + 2, p.rows.len() * 2);
     for _ in 0..n + 2 {
@@ -79,6 +82,64 @@ pub(crate) fn analyse(p: &Plan, conditions: &PlanAnalysis) -> Analysis {
         ends,
         never_matches,
         s0_dead_on_return,
+    }
+}
+
+/// The graph of a plan too large to analyse, from its rows' state patterns
+/// alone: every row may fire wherever its pattern allows. A `*` row is one
+/// edge from a node every state leads to, so the graph stays linear in the
+/// rows however many states there are.
+fn structural(p: &Plan) -> Analysis {
+    let n = p.states.len();
+    let (done, error, any) = (n, n + 1, n + 2);
+    let mut g: DiGraph<(), ()> = DiGraph::with_capacity(n + 3, p.rows.len() + n);
+    for _ in 0..n + 3 {
+        g.add_node(());
+    }
+    // Per state: a row of its own leads elsewhere. Targets of `*` rows.
+    let mut own_exit = vec![false; n];
+    let mut star_targets: Vec<usize> = Vec::new();
+    for row in &p.rows {
+        let to = match row.to {
+            Target::Same => continue,
+            Target::State(s) => s.index(),
+            Target::Done => done,
+            Target::Error(_) => error,
+        };
+        match row.from {
+            crate::ir::From::State(s) if s.index() != to => {
+                own_exit[s.index()] = true;
+                g.add_edge(NodeIndex::new(s.index()), NodeIndex::new(to), ());
+            }
+            crate::ir::From::State(_) => {}
+            crate::ir::From::DontCare(_) => {
+                if !star_targets.contains(&to) {
+                    star_targets.push(to);
+                    g.add_edge(NodeIndex::new(any), NodeIndex::new(to), ());
+                }
+            }
+        }
+    }
+    if !star_targets.is_empty() {
+        for s in 0..n {
+            g.add_edge(NodeIndex::new(s), NodeIndex::new(any), ());
+        }
+    }
+    let mut reachable = vec![false; n + 3];
+    for node in Bfs::new(&g, NodeIndex::new(0)).iter(&g) {
+        reachable[node.index()] = true;
+    }
+    let ends = reachable[done] || reachable[error];
+    let leaves = (0..n)
+        .map(|s| own_exit[s] || star_targets.iter().any(|&t| t != s))
+        .collect();
+    reachable.truncate(n);
+    Analysis {
+        reachable,
+        leaves,
+        ends,
+        never_matches: vec![false; p.rows.len()],
+        s0_dead_on_return: false,
     }
 }
 

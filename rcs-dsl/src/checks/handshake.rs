@@ -31,6 +31,10 @@ pub(crate) fn check_unhandled_error(ir: &Ir, plans: &Plans, sink: &mut Sink) {
         for (pi, p) in c.plans.iter().enumerate() {
             let conditions = &plans.conditions[ci][pi];
             let graph = &plans.graphs[ci][pi];
+            // A plan too large to analyse: nothing can be proved of it.
+            if !conditions.analysed() {
+                continue;
+            }
             // Paths to each state, searched once a finding needs one.
             let paths = std::cell::OnceCell::new();
             for &x in &c.subordinates {

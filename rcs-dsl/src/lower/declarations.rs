@@ -3,7 +3,6 @@
 //! var initialisers and lowers the plans (through `lower::plans`).
 
 use super::expr::Cx;
-use super::index::find;
 use super::{duplicate, resolve_type, ByName, Globals};
 use crate::ast;
 use crate::diagnostic::{Code, Diagnostic, Diagnostics};
@@ -17,10 +16,7 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
         let mut statuses = std::mem::take(&mut ir.controllers[i].statuses);
         let mut errors: Vec<ErrorDef> = Vec::new();
         let (mut command_names, mut error_names) = (ByName::default(), ByName::default());
-        let mut status_names = ByName::default();
-        for (k, st) in statuses.iter().enumerate() {
-            status_names.first_or_insert(&st.name, k);
-        }
+        let mut status_names = ByName::of(statuses.iter().map(|s| s.name.as_str()));
         let mut vars: Vec<Var> = Vec::new();
         let mut hooks: Vec<Hook> = Vec::new();
         // One value namespace: vars, hooks, buffers and subordinates.
@@ -61,9 +57,8 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
             let docs = &e.outer.docs;
             match &e.kind {
                 ast::EntryKind::Command(name, params) => {
-                    if let Some(first) = command_names.first_or_insert(&name.text, commands.len()) {
-                        let first = commands[first].span;
-                        diags.push(duplicate("command", &name.text, name.span, first));
+                    let n = commands.len();
+                    if !command_names.claim("command", name, n, |k| commands[k].span, diags) {
                         continue;
                     }
                     commands.push(Command {
@@ -103,9 +98,8 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                 }
                 ast::EntryKind::Error(names) => {
                     for name in names {
-                        if let Some(first) = error_names.first_or_insert(&name.text, errors.len()) {
-                            let first = errors[first].span;
-                            diags.push(duplicate("error code", &name.text, name.span, first));
+                        let n = errors.len();
+                        if !error_names.claim("error code", name, n, |k| errors[k].span, diags) {
                             continue;
                         }
                         errors.push(ErrorDef {
@@ -162,9 +156,7 @@ fn lower_params(g: &Globals, params: &[ast::Param], diags: &mut Diagnostics) -> 
     let mut out: Vec<Param> = Vec::new();
     let mut names = ByName::default();
     for p in params {
-        if let Some(first) = names.first_or_insert(&p.name.text, out.len()) {
-            let first = out[first].span;
-            diags.push(duplicate("parameter", &p.name.text, p.name.span, first));
+        if !names.claim("parameter", &p.name, out.len(), |k| out[k].span, diags) {
             continue;
         }
         let ty = resolve_type(g, &p.ty, diags).unwrap_or(Type::Unit);
@@ -240,8 +232,7 @@ pub(super) fn lower_controller_body(
                     inits.push((vi, e));
                 }
                 ast::EntryKind::Plan(p) => {
-                    let Some(cmd) = find(&names.controllers[id.index()].commands, &p.verb.text)
-                    else {
+                    let Some(cmd) = names.controllers[id.index()].commands.get(&p.verb.text) else {
                         cx.diags.push(
                             Diagnostic::error(
                                 Code::UnknownCommand,

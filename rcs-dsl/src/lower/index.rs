@@ -5,39 +5,29 @@
 //! million squared comparisons.
 
 use super::expr::Value;
+use super::ByName;
 use crate::ir::{BufferId, HookId, Ir, VarId};
 use std::collections::BTreeMap;
-
-type Positions = BTreeMap<String, u32>;
-
-/// Names to positions, the first declaration of a name winning.
-fn positions<'a>(names: impl Iterator<Item = &'a str>) -> Positions {
-    let mut out = Positions::new();
-    for (i, n) in names.enumerate() {
-        out.entry(n.to_string()).or_insert(i as u32);
-    }
-    out
-}
 
 /// One controller's names.
 pub(in crate::lower) struct ControllerNames {
     /// Vars, then `writes` and `reads` buffers, hooks and subordinates: what
     /// a bare name in an expression stands for, in that order of precedence.
     pub values: BTreeMap<String, Value>,
-    pub statuses: Positions,
-    pub errors: Positions,
-    pub commands: Positions,
+    pub statuses: ByName,
+    pub errors: ByName,
+    pub commands: ByName,
     /// Per command, its parameters.
-    pub params: Vec<Positions>,
+    pub params: Vec<ByName>,
 }
 
 /// The names of the whole IR.
 pub(in crate::lower) struct Index {
     pub controllers: Vec<ControllerNames>,
     /// Per enum, its variants.
-    pub variants: Vec<Positions>,
+    pub variants: Vec<ByName>,
     /// Per buffer type, its fields.
-    pub fields: Vec<Positions>,
+    pub fields: Vec<ByName>,
 }
 
 impl Index {
@@ -79,13 +69,13 @@ impl Index {
                 }
                 ControllerNames {
                     values,
-                    statuses: positions(c.statuses.iter().map(|s| s.name.as_str())),
-                    errors: positions(c.errors.iter().map(|e| e.name.as_str())),
-                    commands: positions(c.commands.iter().map(|k| k.name.as_str())),
+                    statuses: ByName::of(c.statuses.iter().map(|s| s.name.as_str())),
+                    errors: ByName::of(c.errors.iter().map(|e| e.name.as_str())),
+                    commands: ByName::of(c.commands.iter().map(|k| k.name.as_str())),
                     params: c
                         .commands
                         .iter()
-                        .map(|k| positions(k.params.iter().map(|p| p.name.as_str())))
+                        .map(|k| ByName::of(k.params.iter().map(|p| p.name.as_str())))
                         .collect(),
                 }
             })
@@ -95,18 +85,13 @@ impl Index {
             variants: ir
                 .enums
                 .iter()
-                .map(|e| positions(e.variants.iter().map(|v| v.name.as_str())))
+                .map(|e| ByName::of(e.variants.iter().map(|v| v.name.as_str())))
                 .collect(),
             fields: ir
                 .buffer_types
                 .iter()
-                .map(|b| positions(b.fields.iter().map(|f| f.name.as_str())))
+                .map(|b| ByName::of(b.fields.iter().map(|f| f.name.as_str())))
                 .collect(),
         }
     }
-}
-
-/// `name`'s position in `positions`, as an index.
-pub(in crate::lower) fn find(positions: &Positions, name: &str) -> Option<usize> {
-    positions.get(name).map(|&i| i as usize)
 }

@@ -96,6 +96,21 @@ pub fn lower(
 pub(super) struct ByName(BTreeMap<String, usize>);
 
 impl ByName {
+    /// The names of a finished scope, in declaration order (the first of
+    /// two equal names wins).
+    pub(super) fn of<'a>(names: impl Iterator<Item = &'a str>) -> ByName {
+        let mut out = ByName::default();
+        for (i, n) in names.enumerate() {
+            out.first_or_insert(n, i);
+        }
+        out
+    }
+
+    /// The index `name` was first declared at.
+    pub(super) fn get(&self, name: &str) -> Option<usize> {
+        self.0.get(name).copied()
+    }
+
     /// The index `name` was first declared at; else remember `index` for it.
     pub(super) fn first_or_insert(&mut self, name: &str, index: usize) -> Option<usize> {
         if let Some(&i) = self.0.get(name) {
@@ -103,6 +118,26 @@ impl ByName {
         }
         self.0.insert(name.to_string(), index);
         None
+    }
+
+    /// Declare `name` as the `index`-th `what` of this scope: `false`, with
+    /// a `duplicate_definition` against the first declaration's span, when
+    /// the scope has it already.
+    pub(super) fn claim(
+        &mut self,
+        what: &str,
+        name: &ast::Name,
+        index: usize,
+        first_span: impl FnOnce(usize) -> Span,
+        diags: &mut Diagnostics,
+    ) -> bool {
+        match self.first_or_insert(&name.text, index) {
+            Some(first) => {
+                diags.push(duplicate(what, &name.text, name.span, first_span(first)));
+                false
+            }
+            None => true,
+        }
     }
 }
 
@@ -167,8 +202,7 @@ fn lower_enums(g: &Globals, ir: &mut Ir, diags: &mut Diagnostics) {
         let mut variants: Vec<Variant> = Vec::new();
         let mut names = ByName::default();
         for (docs, v) in &e.variants {
-            if let Some(first) = names.first_or_insert(&v.text, variants.len()) {
-                diags.push(duplicate("variant", &v.text, v.span, variants[first].span));
+            if !names.claim("variant", v, variants.len(), |k| variants[k].span, diags) {
                 continue;
             }
             variants.push(Variant {
@@ -280,9 +314,7 @@ fn lower_buffer_types(g: &Globals, ir: &mut Ir, diags: &mut Diagnostics) {
         let mut fields: Vec<FieldDef> = Vec::new();
         let mut names = ByName::default();
         for f in &b.fields {
-            if let Some(first) = names.first_or_insert(&f.name.text, fields.len()) {
-                let first = fields[first].span;
-                diags.push(duplicate("field", &f.name.text, f.name.span, first));
+            if !names.claim("field", &f.name, fields.len(), |k| fields[k].span, diags) {
                 continue;
             }
             // An unresolved field type is reported; the field is kept (as

@@ -3,7 +3,6 @@
 //! expression checker of `lower::expr`.
 
 use super::expr::{Cx, Value};
-use super::index::find;
 use super::*;
 use crate::ast::{self, AssignOp, BinOp};
 use crate::diagnostic::{Code, Diagnostic};
@@ -101,7 +100,7 @@ impl Cx<'_, '_> {
         let to = match &r.target {
             ast::Target::Same(_) => Target::Same,
             ast::Target::Error(None, _) => Target::Error(None),
-            ast::Target::Error(Some(code), _) => match find(&self.names().errors, &code.text) {
+            ast::Target::Error(Some(code), _) => match self.names().errors.get(&code.text) {
                 Some(i) => Target::Error(Some(ErrorId(i as u32))),
                 None => {
                     self.diags.push(
@@ -143,7 +142,7 @@ impl Cx<'_, '_> {
 
     pub(in crate::lower) fn job(&mut self, j: &ast::Job) -> Option<Job> {
         match j {
-            ast::Job::Report(name, span) => match find(&self.names().statuses, &name.text) {
+            ast::Job::Report(name, span) => match self.names().statuses.get(&name.text) {
                 Some(i) if i >= 4 => Some(Job::Report {
                     status: StatusId(i as u32),
                     span: *span,
@@ -267,7 +266,7 @@ impl Cx<'_, '_> {
             }
         };
         let target = &self.ir.controllers[sid.index()];
-        let Some(ci) = find(&self.ix.controllers[sid.index()].commands, &verb.text) else {
+        let Some(ci) = self.ix.controllers[sid.index()].commands.get(&verb.text) else {
             self.diags.push(
                 Diagnostic::error(
                     Code::UnknownCommand,
@@ -294,7 +293,7 @@ impl Cx<'_, '_> {
         let mut seen: Vec<Option<Span>> = vec![None; command.params.len()];
         let mut ok = true;
         for (n, a) in args {
-            match find(&self.ix.controllers[sid.index()].params[ci], &n.text) {
+            match self.ix.controllers[sid.index()].params[ci].get(&n.text) {
                 None => {
                     self.diags.push(
                         Diagnostic::error(
@@ -429,7 +428,7 @@ impl Cx<'_, '_> {
                 match &p.ty {
                     Type::Buffer(bid) => {
                         let bty = &self.ir.buffer_types[bid.index()];
-                        match find(&self.ix.fields[bid.index()], &f.text) {
+                        match self.ix.fields[bid.index()].get(&f.text) {
                             Some(fi) => {
                                 p.ty = bty.fields[fi].ty.clone();
                                 if p.ty == Type::Unit {

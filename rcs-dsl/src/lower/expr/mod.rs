@@ -9,7 +9,7 @@
 mod names;
 mod operators;
 
-use super::index::{find, ControllerNames, Index};
+use super::index::{ControllerNames, Index};
 
 use super::{primitive, Globals, ItemRef};
 use crate::ast::{self, BinOp, UnOp};
@@ -244,7 +244,7 @@ impl Cx<'_, '_> {
                     return self.not_const(span, "a command parameter");
                 };
                 let command = &self.c.commands[cmd.index()];
-                match find(&self.names().params[cmd.index()], &p.text) {
+                match self.names().params[cmd.index()].get(&p.text) {
                     Some(pi) => {
                         let ty = command.params[pi].ty.clone();
                         if ty == Type::Unit {

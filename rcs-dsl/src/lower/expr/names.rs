@@ -41,7 +41,7 @@ impl Cx<'_, '_> {
             return match self.g.names.get(q.text.as_str()) {
                 Some((ItemRef::Enum(eid), _)) => {
                     let en = &self.ir.enums[eid.index()];
-                    match find(&self.ix.variants[eid.index()], &name.text) {
+                    match self.ix.variants[eid.index()].get(&name.text) {
                         Some(vi) => (
                             mk(ExprKind::Variant(*eid, vi as u32), Type::Enum(*eid)),
                             Ty::Known(Type::Enum(*eid)),
@@ -69,7 +69,7 @@ impl Cx<'_, '_> {
                 }
                 Some((ItemRef::Controller(cid), _)) => {
                     let ctrl = &self.ir.controllers[cid.index()];
-                    match find(&self.ix.controllers[cid.index()].statuses, &name.text) {
+                    match self.ix.controllers[cid.index()].statuses.get(&name.text) {
                         Some(si) => (
                             mk(ExprKind::Status(StatusId(si as u32)), Type::Status(*cid)),
                             Ty::Known(Type::Status(*cid)),
@@ -150,7 +150,7 @@ impl Cx<'_, '_> {
             }
             Some(Type::Status(cid)) => {
                 let ctrl = &self.ir.controllers[cid.index()];
-                if let Some(si) = find(&self.ix.controllers[cid.index()].statuses, &name.text) {
+                if let Some(si) = self.ix.controllers[cid.index()].statuses.get(&name.text) {
                     return (
                         mk(ExprKind::Status(StatusId(si as u32)), Type::Status(*cid)),
                         Ty::Known(Type::Status(*cid)),
@@ -372,7 +372,7 @@ impl Cx<'_, '_> {
             Ty::Err => (err_expr(span), Ty::Err),
             Ty::Known(Type::Buffer(bid)) => {
                 let bty = &self.ir.buffer_types[bid.index()];
-                match find(&self.ix.fields[bid.index()], &field.text) {
+                match self.ix.fields[bid.index()].get(&field.text) {
                     Some(fi) => {
                         let ty = bty.fields[fi].ty.clone();
                         if ty == Type::Unit {

@@ -206,13 +206,7 @@ impl<'ir> PlanAnalysis<'ir> {
             return None;
         }
         let leaf = self.terms.find(&Leaf::SubStatus(sub))?;
-        let mut any = Vec::new();
-        for (i, row) in self.plan.rows.iter().enumerate() {
-            if covers(&row.from, state) {
-                // An `otherwise` row matches when nothing else does.
-                any.push(Formula::Shared(self.conds[i].clone()?));
-            }
-        }
+        let any = self.conditions_covering(state)?;
         let mut fixed = self.fixed(state);
         fixed.push((leaf, Value::Status(status.0 as u16)));
         let some_row = Formula::Or(any);
@@ -285,19 +279,7 @@ impl<'ir> PlanAnalysis<'ir> {
             if assigned.contains(v) {
                 continue;
             }
-            let mut value = initial.vars()[v.index()].clone();
-            for s in steps {
-                value = match (s, value) {
-                    (terms::Step::Field(f), Value::Buffer(mut fs)) if (*f as usize) < fs.len() => {
-                        fs.swap_remove(*f as usize)
-                    }
-                    (terms::Step::Index(i), Value::Array(mut xs)) if (*i as usize) < xs.len() => {
-                        xs.swap_remove(*i as usize)
-                    }
-                    _ => Value::Unit,
-                };
-            }
-            if value != Value::Unit {
+            if let Some(value) = path::at_path(&initial.vars()[v.index()], steps) {
                 out.push((l, value));
             }
         }

@@ -430,7 +430,7 @@ struct Scene {
 }
 
 /// The part of `v` at `steps`.
-fn at_path(v: &Value, steps: &[Step]) -> Option<Value> {
+pub(super) fn at_path(v: &Value, steps: &[Step]) -> Option<Value> {
     let mut v = v;
     for s in steps {
         v = match (s, v) {

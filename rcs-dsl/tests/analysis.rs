@@ -11,8 +11,10 @@
 //! one — can be replayed by issuing the command and running one or two
 //! cycles.
 
+mod common;
+
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+use proptest::test_runner::{RngAlgorithm, TestRng};
 use rcs_dsl::analysis::terms::{Leaf, Step};
 use rcs_dsl::analysis::{Answer, PlanAnalysis, Witness};
 use rcs_dsl::interp;
@@ -267,18 +269,8 @@ fn check_plan(text: &str, rng: &mut TestRng) {
 
 #[test]
 fn never_means_never_and_witnesses_fire_their_rows() {
-    let cases: u32 = std::env::var("RCS_ANALYSIS_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(300);
-    let config = Config {
-        cases,
-        failure_persistence: None,
-        rng_algorithm: RngAlgorithm::ChaCha,
-        ..Config::default()
-    };
-    let mut runner =
-        TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
+    let mut runner = common::deterministic_runner("RCS_ANALYSIS_CASES", 300);
+    let cases = runner.config().cases;
     let rng = std::sync::Mutex::new(TestRng::deterministic_rng(RngAlgorithm::ChaCha));
     runner
         .run(&plan(), |text| {

@@ -10,6 +10,8 @@
 //! - a row found unreachable because of the values its state is entered
 //!   with never fires in random runs, which do visit that state.
 
+mod common;
+
 use proptest::prelude::RngExt;
 use proptest::test_runner::{RngAlgorithm, TestRng};
 use rcs_dsl::analysis::command::Step;
@@ -484,19 +486,8 @@ fn never_fires(ir: &Ir, cid: CtrlId, row: usize, rng: &mut TestRng, text: &str) 
 
 #[test]
 fn random_plans_hangs_replay_and_bound_rows_never_fire() {
-    use proptest::test_runner::{Config, TestRunner};
-    let cases: u32 = std::env::var("RCS_HANG_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(300);
-    let config = Config {
-        cases,
-        failure_persistence: None,
-        rng_algorithm: RngAlgorithm::ChaCha,
-        ..Config::default()
-    };
-    let mut runner =
-        TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
+    let mut runner = common::deterministic_runner("RCS_HANG_CASES", 300);
+    let cases = runner.config().cases;
     let rng = std::sync::Mutex::new(TestRng::deterministic_rng(RngAlgorithm::ChaCha));
     let counts = std::sync::Mutex::new((0usize, 0usize));
     runner

@@ -15,8 +15,9 @@
 //! The check and this test share one computation,
 //! `rcs_dsl::analysis::cycles`.
 
+mod common;
+
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use rcs_dsl::analysis::cycles::{command_storms, livelocks, Inputs, Step};
 use rcs_dsl::analysis::terms::{Leaf, Step as PathStep};
 use rcs_dsl::analysis::PlanAnalysis;
@@ -326,14 +327,7 @@ controller X {{
 /// claimed: no false alarm. Not vacuous: both are found in some.
 #[test]
 fn random_plans_replay_every_finding() {
-    let config = Config {
-        cases: 800,
-        failure_persistence: None,
-        rng_algorithm: RngAlgorithm::ChaCha,
-        ..Config::default()
-    };
-    let mut runner =
-        TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
+    let mut runner = common::deterministic_runner("RCS_LOOPS_CASES", 800);
     let found = std::cell::Cell::new((0, 0));
     runner
         .run(&random_plan(), |text| {

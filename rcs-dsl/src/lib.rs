@@ -31,6 +31,7 @@ pub mod lint;
 pub mod load;
 mod lower;
 pub mod manifest;
+mod parallel;
 pub mod parser;
 pub mod pretty;
 pub mod render;
@@ -70,14 +71,26 @@ impl Checked {
 /// Check a loaded plan set: parse, lower, validate.
 pub fn check(set: &PlanSet, options: &Options) -> Checked {
     let mut diags = Diagnostics::new();
-    let Some(ir) = front(set, &mut diags) else {
+    let Some(files) = parse(set, &mut diags) else {
+        return finish(None, diags);
+    };
+    let Some(ir) = lower_files(set, &files, &mut diags) else {
         return finish(None, diags);
     };
     let mut levels = LintLevels::default();
     for &(lint, level) in set.manifest.lints.iter().chain(&options.lint_flags) {
         levels.set(lint, level);
     }
-    checks::run(&ir, &levels, &set.sources, &mut diags);
+    std::thread::scope(|scope| {
+        // Freeing a large AST is a visible share of `check`: it happens
+        // beside the checks instead of before them.
+        if rcs_bytes(set) >= PARALLEL_BYTES {
+            scope.spawn(move || drop(files));
+        } else {
+            drop(files);
+        }
+        checks::run(&ir, &levels, &set.sources, &mut diags);
+    });
     let ir = (!diags.has_errors()).then_some(ir);
     finish(ir, diags)
 }
@@ -92,6 +105,12 @@ pub fn lower_unchecked(set: &PlanSet) -> Option<ir::Ir> {
 
 /// Stages 0–2: the load diagnostics, parsing and lowering.
 fn front(set: &PlanSet, diags: &mut Diagnostics) -> Option<ir::Ir> {
+    let files = parse(set, diags)?;
+    lower_files(set, &files, diags)
+}
+
+/// Stages 0 and 1: the load diagnostics and parsing; `None` on an error.
+fn parse(set: &PlanSet, diags: &mut Diagnostics) -> Option<Vec<ast::File>> {
     // Stage 0 (load and manifest) and stage 1 (parse) are independent, so
     // their errors are reported together.
     let unreadable: Vec<source::FileId> = set
@@ -120,6 +139,11 @@ fn front(set: &PlanSet, diags: &mut Diagnostics) -> Option<ir::Ir> {
     if diags.has_errors() {
         return None;
     }
+    Some(files)
+}
+
+/// Stage 2: lowering parsed files; `None` on an error.
+fn lower_files(set: &PlanSet, files: &[ast::File], diags: &mut Diagnostics) -> Option<ir::Ir> {
     let system = set
         .manifest
         .system
@@ -132,7 +156,7 @@ fn front(set: &PlanSet, diags: &mut Diagnostics) -> Option<ir::Ir> {
         .map(|(id, _)| set.relative_path(id))
         .collect();
     let ir = lower::lower(
-        &files,
+        files,
         file_names,
         &set.manifest,
         &system,
@@ -144,28 +168,21 @@ fn front(set: &PlanSet, diags: &mut Diagnostics) -> Option<ir::Ir> {
 
 type Parsed = Result<ast::File, Vec<Diagnostic>>;
 
-/// Parse files, on as many threads as the machine has (files are
+/// Below this much `.rcs` text a thread costs more than it saves.
+const PARALLEL_BYTES: usize = 256 * 1024;
+
+fn rcs_bytes(set: &PlanSet) -> usize {
+    set.rcs_files
+        .iter()
+        .map(|id| set.sources.get(*id).text.len())
+        .sum()
+}
+
+/// Parse files, on both cores when there is enough text (files are
 /// independent), returning results in the order of `ids`.
 fn parse_all(set: &PlanSet, ids: &[source::FileId]) -> Vec<Parsed> {
-    let parse = |id: &source::FileId| parser::parse_file(*id, &set.sources.get(*id).text);
-    let bytes: usize = ids.iter().map(|id| set.sources.get(*id).text.len()).sum();
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(ids.len());
-    // Below ~256 KiB a thread costs more than it saves.
-    if threads < 2 || bytes < 256 * 1024 {
-        return ids.iter().map(parse).collect();
-    }
-    let chunk = ids.len().div_ceil(threads);
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = ids
-            .chunks(chunk)
-            .map(|part| scope.spawn(move || part.iter().map(parse).collect::<Vec<_>>()))
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-            .collect()
+    parallel::map_ordered(ids, rcs_bytes(set) >= PARALLEL_BYTES, |id| {
+        parser::parse_file(*id, &set.sources.get(*id).text)
     })
 }
 

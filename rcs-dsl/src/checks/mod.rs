@@ -105,12 +105,25 @@ pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagno
     let plans = handshake::Plans { conditions, graphs };
     handshake::check_unhandled_error(ir, &plans, &mut sink);
     handshake::check_status_never_reported(ir, &plans, &mut sink);
-    hierarchy::check_span_of_control(ir, &mut sink);
-    hierarchy::check_level_order(ir, &mut sink);
-    usage::check_float_equality(ir, &mut sink);
-    usage::check_unused(ir, &mut sink);
+    let many = plans.conditions.iter().map(Vec::len).sum::<usize>() >= PARALLEL_PLANS;
+    std::thread::scope(|scope| {
+        // Freeing the analyses of many plans takes about as long as the
+        // checks below: it happens beside them.
+        if many {
+            scope.spawn(move || drop(plans));
+        } else {
+            drop(plans);
+        }
+        hierarchy::check_span_of_control(ir, &mut sink);
+        hierarchy::check_level_order(ir, &mut sink);
+        usage::check_float_equality(ir, &mut sink);
+        usage::check_unused(ir, &mut sink);
+    });
     diags.sort_from(start, sources);
 }
+
+/// Below a few dozen plans a thread costs more than it saves.
+const PARALLEL_PLANS: usize = 64;
 
 /// Per controller: the analysis of each plan's conditions, each plan's
 /// graph, and the findings of the checks of its plans.
@@ -184,35 +197,10 @@ fn check_plan(
 /// (and their order) do not depend on the threads.
 fn analyse_plans<'ir>(ir: &'ir Ir, levels: &LintLevels) -> Analysed<'ir> {
     let plans: usize = ir.controllers.iter().map(|c| c.plans.len()).sum();
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(ir.controllers.len());
-    // Below a few dozen plans a thread costs more than it saves.
-    let per_controller: Vec<_> = if threads < 2 || plans < 64 {
-        ir.controllers
-            .iter()
-            .map(|c| analyse_controller(ir, c, levels))
-            .collect()
-    } else {
-        let chunk = ir.controllers.len().div_ceil(threads);
-        std::thread::scope(|scope| {
-            let handles: Vec<_> = ir
-                .controllers
-                .chunks(chunk)
-                .map(|part| {
-                    scope.spawn(move || {
-                        part.iter()
-                            .map(|c| analyse_controller(ir, c, levels))
-                            .collect::<Vec<_>>()
-                    })
-                })
-                .collect();
-            handles
-                .into_iter()
-                .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-                .collect()
-        })
-    };
+    let per_controller =
+        crate::parallel::map_ordered(&ir.controllers, plans >= PARALLEL_PLANS, |c| {
+            analyse_controller(ir, c, levels)
+        });
     let mut out: Analysed = (Vec::new(), Vec::new(), Vec::new());
     for (a, g, d) in per_controller {
         out.0.push(a);

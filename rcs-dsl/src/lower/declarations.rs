@@ -174,11 +174,12 @@ fn lower_params(g: &Globals, params: &[ast::Param], diags: &mut Diagnostics) -> 
 pub(super) fn lower_controller_body(
     g: &Globals,
     names: &super::index::Index,
-    ir: &mut Ir,
+    ir: &Ir,
     id: CtrlId,
     c: &ast::ControllerDef,
-    diags: &mut Diagnostics,
-) {
+) -> ControllerBody {
+    let mut diags = Diagnostics::new();
+    let diags = &mut diags;
     let mut inits = Vec::new();
     let mut plans: Vec<Plan> = Vec::new();
     let mut plan_of: Vec<Option<PlanId>> = vec![None; ir.controllers[id.index()].commands.len()];
@@ -260,12 +261,34 @@ pub(super) fn lower_controller_body(
             }
         }
     }
-    let ctrl = &mut ir.controllers[id.index()];
-    for (vi, e) in inits {
-        ctrl.vars[vi].init = Some(e);
+    ControllerBody {
+        inits,
+        plans,
+        plan_of,
+        diags: std::mem::take(diags),
     }
-    for (cmd, p) in ctrl.commands.iter_mut().zip(plan_of) {
-        cmd.plan = p;
+}
+
+/// What lowering a controller's body produced, computed from a shared `&Ir`
+/// (so that controllers are lowered on worker threads) and then put into
+/// the controller by [`ControllerBody::apply`].
+pub(super) struct ControllerBody {
+    /// Each var's initial value, by the var's index.
+    inits: Vec<(usize, Expr)>,
+    plans: Vec<Plan>,
+    /// Each command's plan, by the command's index.
+    plan_of: Vec<Option<PlanId>>,
+    pub diags: Diagnostics,
+}
+
+impl ControllerBody {
+    pub(super) fn apply(self, ctrl: &mut Controller) {
+        for (vi, e) in self.inits {
+            ctrl.vars[vi].init = Some(e);
+        }
+        for (cmd, p) in ctrl.commands.iter_mut().zip(self.plan_of) {
+            cmd.plan = p;
+        }
+        ctrl.plans = self.plans;
     }
-    ctrl.plans = plans;
 }

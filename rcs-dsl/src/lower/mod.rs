@@ -68,9 +68,21 @@ pub fn lower(
     let ctrl_asts = lower_controller_headers(&globals, &mut ir, sources, diags);
     check_hierarchy_cycles(&ir, diags);
     let names = index::Index::new(&ir);
-    for (i, c) in ctrl_asts.iter().enumerate() {
-        let id = CtrlId(i as u32);
-        declarations::lower_controller_body(&globals, &names, &mut ir, id, c, diags);
+    // Controller bodies only read the declarations lowered so far, so they
+    // are lowered in parallel; their plans and diagnostics are put back in
+    // controller order.
+    let ids: Vec<(CtrlId, &ast::ControllerDef)> = ctrl_asts
+        .iter()
+        .enumerate()
+        .map(|(i, c)| (CtrlId(i as u32), *c))
+        .collect();
+    let rows: usize = ids.iter().map(|(_, c)| c.entries.len()).sum();
+    let bodies = crate::parallel::map_ordered(&ids, rows >= 2048, |&(id, c)| {
+        declarations::lower_controller_body(&globals, &names, &ir, id, c)
+    });
+    for ((id, _), mut body) in ids.iter().zip(bodies) {
+        diags.extend(std::mem::take(&mut body.diags));
+        body.apply(&mut ir.controllers[id.index()]);
     }
     ir.schedule = lower_schedule(&ir, manifest, diags);
     for c in &mut ir.controllers {

@@ -4,6 +4,15 @@
 
 use super::*;
 
+/// The parts of one operand: `op_unary* postfix_expr (as T)*`.
+#[derive(Default)]
+struct Operand<'i> {
+    /// Each prefix: whether it is `!` (else `-`), and its span.
+    prefixes: Vec<(bool, Span)>,
+    base: Option<Pair<'i, Rule>>,
+    casts: Vec<Pair<'i, Rule>>,
+}
+
 impl Builder {
     pub(in crate::parser) fn expr(&mut self, p: Pair<Rule>) -> Expr {
         self.expr_at(p, 0)
@@ -50,27 +59,39 @@ impl Builder {
             ));
             d
         };
+        // The grammar's `operand` is silent (see grammar.pest), so its
+        // parts arrive flat: `op_unary* postfix_expr
+        // (as T)*`, then an operator or the end.
+        let mut parts = Operand::default();
         for c in p.into_inner() {
-            if c.as_rule() == Rule::operand {
-                let (e, d) = self.operand(c, depth);
-                operands.push((e, d));
-                continue;
-            }
-            let op = bin_op(c.as_str());
-            // Left-associative: reduce while the stacked operator binds at least as tightly.
-            while let Some(&top) = ops.last() {
-                if top.precedence() < op.precedence() {
-                    break;
+            match c.as_rule() {
+                Rule::op_unary => parts.prefixes.push((c.as_str() == "!", self.span(&c))),
+                Rule::postfix_expr => parts.base = Some(c),
+                Rule::ident => parts.casts.push(c),
+                Rule::infix => {
+                    let operand = std::mem::take(&mut parts);
+                    operands.push(self.operand(operand, depth));
+                    let op = bin_op(c.as_str());
+                    // Left-associative: reduce while the stacked operator binds at least as tightly.
+                    while let Some(&top) = ops.last() {
+                        if top.precedence() < op.precedence() {
+                            break;
+                        }
+                        ops.pop();
+                        if reduce(&mut operands, top) + depth > MAX_EXPR_DEPTH {
+                            failed = true;
+                        }
+                    }
+                    ops.push(op);
+                    if failed {
+                        break;
+                    }
                 }
-                ops.pop();
-                if reduce(&mut operands, top) + depth > MAX_EXPR_DEPTH {
-                    failed = true;
-                }
+                _ => {}
             }
-            ops.push(op);
-            if failed {
-                break;
-            }
+        }
+        if !failed {
+            operands.push(self.operand(parts, depth));
         }
         if failed {
             return self.too_deep(span);
@@ -84,18 +105,12 @@ impl Builder {
     }
 
     /// `op_unary* postfix (as T)*`; returns the node and its height.
-    pub(in crate::parser) fn operand(&mut self, p: Pair<Rule>, depth: usize) -> (Expr, usize) {
-        let mut prefixes = Vec::new();
-        let mut base = None;
-        let mut casts = Vec::new();
-        for c in p.into_inner() {
-            match c.as_rule() {
-                Rule::op_unary => prefixes.push((c.as_str() == "!", self.span(&c))),
-                Rule::postfix_expr => base = Some(c),
-                Rule::ident => casts.push(c),
-                _ => {}
-            }
-        }
+    fn operand(&mut self, parts: Operand, depth: usize) -> (Expr, usize) {
+        let Operand {
+            prefixes,
+            base,
+            casts,
+        } = parts;
         let wrappers = prefixes.len() + casts.len();
         let base = base.expect("operand has a base");
         if wrappers + depth > MAX_EXPR_DEPTH {

@@ -16,6 +16,7 @@
 //! over a file rcsc did not generate (see its docs for what it promises).
 
 pub mod config;
+pub mod diff;
 pub mod dot;
 pub mod ident;
 pub mod rust;

@@ -101,18 +101,27 @@ pub(crate) fn merge_edges(rows: impl IntoIterator<Item = (String, String, Line)>
 /// label to its arc when other edges enter the same node.
 fn edge_attrs(edge: &Edge, all: &[Edge]) -> String {
     let mut label = String::new();
+    // One row: its line, its jobs centred under it. Several: every line
+    // left-aligned, the jobs indented under their row.
+    let (br, indent) = match edge.lines.len() {
+        1 => ("<BR/>", ""),
+        _ => ("<BR ALIGN=\"LEFT\"/>", "   "),
+    };
     for line in &edge.lines {
         let (open, close) = match line.color {
             Some(c) => (format!("<FONT COLOR=\"{c}\">"), "</FONT>"),
             None => (String::new(), ""),
         };
-        let _ = write!(label, "{open}{}{close}<BR ALIGN=\"LEFT\"/>", html(&line.text));
+        let _ = write!(label, "{open}{}{close}", html(&line.text));
         if !line.jobs.is_empty() {
             let _ = write!(
                 label,
-                "<FONT POINT-SIZE=\"8\">{open}   {}{close}</FONT><BR ALIGN=\"LEFT\"/>",
+                "{br}<FONT POINT-SIZE=\"8\">{open}{indent}{}{close}</FONT>",
                 html(&line.jobs)
             );
+        }
+        if edge.lines.len() > 1 {
+            label.push_str(br);
         }
     }
     let tips: Vec<&str> = edge.lines.iter().map(|l| l.tooltip.as_str()).collect();

@@ -129,3 +129,21 @@ fn revisions_of_a_git_repository() {
     assert!(same.stdout.is_empty());
     let _ = std::fs::remove_dir_all(&repo);
 }
+
+#[test]
+fn the_readme_example_is_what_rcsc_diff_prints() {
+    let readme = std::fs::read_to_string("README.md").unwrap();
+    let at = readme
+        .find("(`tests/data/diff/reordered`)")
+        .expect("README.md shows the markdown of the reordered case");
+    let block = readme[at..]
+        .split_once("```markdown\n")
+        .and_then(|(_, rest)| rest.split_once("\n```"))
+        .map(|(block, _)| block)
+        .expect("a ```markdown block");
+    let out = rcsc_in(
+        Path::new("tests/data/diff/reordered"),
+        &["diff", "old", "new", "--format", "markdown"],
+    );
+    assert_eq!(text(&out.stdout).trim_end(), block);
+}

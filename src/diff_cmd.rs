@@ -54,10 +54,16 @@ pub(crate) fn diff(args: DiffArgs) -> ExitCode {
 }
 
 fn run(args: &DiffArgs) -> Result<ExitCode, String> {
-    let (old, new) = sides(&args.old, args.new.as_deref(), &default_paths(args.paths.clone()))?;
+    let (old, new) = sides(
+        &args.old,
+        args.new.as_deref(),
+        &default_paths(args.paths.clone()),
+    )?;
     // A revision compared with a path reads the same path in the revision.
     let paths = match (&old, &new) {
-        (Where::Rev(_), Where::Paths(p)) | (Where::Paths(p), Where::Rev(_)) if args.paths.is_empty() => {
+        (Where::Rev(_), Where::Paths(p)) | (Where::Paths(p), Where::Rev(_))
+            if args.paths.is_empty() =>
+        {
             p.clone()
         }
         _ => default_paths(args.paths.clone()),
@@ -72,10 +78,15 @@ fn run(args: &DiffArgs) -> Result<ExitCode, String> {
         for set in sets {
             let (ir, diags) = check_side(set, &options);
             let Some(ir) = ir else {
-                for d in diags.iter().filter(|d| d.severity == rcs_dsl::Severity::Error) {
+                for d in diags
+                    .iter()
+                    .filter(|d| d.severity == rcs_dsl::Severity::Error)
+                {
                     eprint!("{}", render::render(d, &set.sources, args.common.format()));
                 }
-                return Err(format!("the {label} side does not parse; nothing to compare"));
+                return Err(format!(
+                    "the {label} side does not parse; nothing to compare"
+                ));
             };
             side.push((ir, diags));
         }
@@ -98,9 +109,7 @@ fn run(args: &DiffArgs) -> Result<ExitCode, String> {
     let text = match args.format {
         DiffFormat::Text => rcs_codegen::diff::text(&diff, color(args.common.color)),
         DiffFormat::Markdown => rcs_codegen::diff::markdown(&diff),
-        DiffFormat::Json => {
-            serde_json::to_string_pretty(&diff).map_err(|e| e.to_string())? + "\n"
-        }
+        DiffFormat::Json => serde_json::to_string_pretty(&diff).map_err(|e| e.to_string())? + "\n",
     };
     let code = emit(None, text.as_bytes());
     if code != ExitCode::SUCCESS {
@@ -119,7 +128,10 @@ fn sides(old: &str, new: Option<&str>, paths: &[PathBuf]) -> Result<(Where, Wher
     if new.is_none() && !Path::new(old).exists() {
         if let Some((a, b)) = old.split_once("..") {
             let b = b.trim_start_matches('.');
-            return Ok((revision(a)?, revision(if b.is_empty() { "HEAD" } else { b })?));
+            return Ok((
+                revision(a)?,
+                revision(if b.is_empty() { "HEAD" } else { b })?,
+            ));
         }
     }
     let new = match new {
@@ -242,7 +254,9 @@ fn color(choice: ColorChoice) -> bool {
     match choice {
         ColorChoice::Always => true,
         ColorChoice::Never => false,
-        ColorChoice::Auto => std::io::stdout().is_terminal() && std::env::var_os("NO_COLOR").is_none(),
+        ColorChoice::Auto => {
+            std::io::stdout().is_terminal() && std::env::var_os("NO_COLOR").is_none()
+        }
     }
 }
 
@@ -251,7 +265,11 @@ fn color(choice: ColorChoice) -> bool {
 fn write_graphs(dir: &Path, diff: &PlanSetDiff, source: &str) -> Result<(), String> {
     let several = diff.systems.len() > 1;
     for s in &diff.systems {
-        let folder = if several { dir.join(&s.name) } else { dir.to_path_buf() };
+        let folder = if several {
+            dir.join(&s.name)
+        } else {
+            dir.to_path_buf()
+        };
         for p in s.controllers.iter().flat_map(|c| &c.plans) {
             std::fs::create_dir_all(&folder)
                 .map_err(|e| format!("cannot create {}: {e}", folder.display()))?;

@@ -21,7 +21,7 @@ fn cases() -> Vec<String> {
 #[test]
 fn golden_cases() {
     let cases = cases();
-    assert!(cases.len() >= 7, "{cases:?}");
+    assert!(cases.len() >= 8, "{cases:?}");
     for case in cases {
         let dir = Path::new("tests/data/diff").join(&case);
         let out = rcsc_in(&dir, &["diff", "old", "new"]);
@@ -40,7 +40,10 @@ fn golden_cases() {
 
 #[test]
 fn whitespace_only_is_no_change() {
-    let out = rcsc_in(Path::new("tests/data/diff/whitespace_only"), &["diff", "old", "new"]);
+    let out = rcsc_in(
+        Path::new("tests/data/diff/whitespace_only"),
+        &["diff", "old", "new"],
+    );
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     assert!(out.stdout.is_empty(), "{}", text(&out.stdout));
 }
@@ -55,8 +58,23 @@ fn a_reordered_plan_draws_its_move() {
     );
     assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
     let dot = std::fs::read_to_string(graphs.join("TANK.FILL.dot")).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
     insta::assert_snapshot!("diff_reordered_graph", dot);
+    // An otherwise row is a note, coloured as its row.
+    let out = rcsc_in(
+        Path::new("tests/data/diff/otherwise_added"),
+        &["diff", "old", "new", "--graphs", graphs.to_str().unwrap()],
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+    let dot = std::fs::read_to_string(graphs.join("TANK.FILL.dot")).unwrap();
+    assert!(
+        dot.contains("\"E5 otherwise\" [label=<+ E5 otherwise<BR/>"),
+        "{dot}"
+    );
+    assert!(
+        dot.contains("shape=note, style=dashed, color=darkgreen"),
+        "{dot}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -74,8 +92,14 @@ fn json_names_the_move_and_its_witness() {
     assert_eq!(m["was"], "E2");
     let effect = &m["effect"]["changes_firing"];
     assert_eq!(effect["state"], "S1");
-    assert!(effect["input"].as_str().unwrap().contains("s.depth = "), "{effect}");
-    assert_eq!(v["systems"][0]["findings_introduced"][0]["code"], "shadowed_row");
+    assert!(
+        effect["input"].as_str().unwrap().contains("s.depth = "),
+        "{effect}"
+    );
+    assert_eq!(
+        v["systems"][0]["findings_introduced"][0]["code"],
+        "shadowed_row"
+    );
 }
 
 #[test]
@@ -106,7 +130,10 @@ fn revisions_of_a_git_repository() {
     let new = std::fs::read_to_string(case.join("new/tank.rcs")).unwrap();
     let repo = scratch(
         "diff-git",
-        &[("plans/tank.rcs", &old), ("plans/rcs.yaml", "system: tank\n")],
+        &[
+            ("plans/tank.rcs", &old),
+            ("plans/rcs.yaml", "system: tank\n"),
+        ],
     );
     git(&repo, &["init", "-q"]);
     git(&repo, &["add", "."]);
@@ -118,7 +145,12 @@ fn revisions_of_a_git_repository() {
     // two commits named as a range, give the same diff as the folders.
     let folders = rcsc_in(case, &["diff", "old", "new"]);
     let against_tree = rcsc_in(&repo, &["diff", "HEAD~1", "--path", "plans"]);
-    assert_eq!(against_tree.status.code(), Some(1), "{}", text(&against_tree.stderr));
+    assert_eq!(
+        against_tree.status.code(),
+        Some(1),
+        "{}",
+        text(&against_tree.stderr)
+    );
     assert_eq!(text(&against_tree.stdout), text(&folders.stdout));
     let range = rcsc_in(&repo.join("plans"), &["diff", "HEAD~1..HEAD"]);
     assert_eq!(range.status.code(), Some(1), "{}", text(&range.stderr));

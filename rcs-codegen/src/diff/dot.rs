@@ -40,6 +40,7 @@ pub fn diff_dot(plan: &PlanDiff, source: &str) -> String {
         .collect();
     let mut nodes: Vec<String> = Vec::new();
     let mut edges = Vec::new();
+    let mut notes = Vec::new();
     for r in &plan.rows {
         let Some(v) = r.new.as_ref().or(r.old.as_ref()) else {
             continue;
@@ -59,7 +60,8 @@ pub fn diff_dot(plan: &PlanDiff, source: &str) -> String {
         if let (RowChange::Changed(_), Some(o)) = (&r.change, &r.old) {
             tooltip.push_str(&format!("\nwas: {}", o.text()));
         }
-        let mut text = format!("{mark}{sign}{}: {}", v.label, v.condition);
+        let sep = if v.otherwise { " " } else { ": " };
+        let mut text = format!("{mark}{sign}{}{sep}{}", v.label, v.condition);
         if v.target.starts_with("Error(") {
             text.push_str(&format!(" → {}", v.target));
         }
@@ -69,11 +71,17 @@ pub fn diff_dot(plan: &PlanDiff, source: &str) -> String {
             tooltip,
             color: color(r),
         };
-        let (from, to) = if v.otherwise {
-            (format!("{} otherwise", v.label), v.to_node().replace('*', "otherwise *"))
-        } else {
-            (v.from_node(), v.to_node())
-        };
+        if v.otherwise {
+            // Not an edge of any state: a note, with an arrow when it
+            // leaves the state (as in `crate::dot`).
+            let to = (v.target != "same").then(|| v.to_node());
+            if let Some(t) = to.as_ref().filter(|t| !nodes.contains(t)) {
+                nodes.push(t.clone());
+            }
+            notes.push((format!("{} otherwise", v.label), line, to));
+            continue;
+        }
+        let (from, to) = (v.from_node(), v.to_node());
         for n in [&from, &to] {
             if !nodes.contains(n) {
                 nodes.push(n.clone());
@@ -83,14 +91,30 @@ pub fn diff_dot(plan: &PlanDiff, source: &str) -> String {
     }
     for n in &nodes {
         let mut attrs = node_attrs(n);
-        if n.ends_with(" otherwise") {
-            attrs = "shape=note, style=dashed".to_string();
-        } else if plan.states_added.contains(n) {
+        if plan.states_added.contains(n) {
             attrs = format!("color={GREEN}, fontcolor={GREEN}, penwidth=2");
         } else if plan.states_removed.contains(n) {
             attrs = format!("color={RED}, fontcolor={RED}, style=dashed");
         }
         let _ = writeln!(out, "    {} [{attrs}];", quoted(n));
+    }
+    for (id, line, to) in &notes {
+        let c = line.color.unwrap_or("black");
+        let _ = writeln!(
+            out,
+            "    {} [label=<{}>, shape=note, style=dashed, color={c}, fontcolor={c}, tooltip={}];",
+            quoted(id),
+            note_label(line),
+            quoted(&line.tooltip)
+        );
+        if let Some(to) = to {
+            let _ = writeln!(
+                out,
+                "    {} -> {} [style=dashed, color={c}];",
+                quoted(id),
+                quoted(to)
+            );
+        }
     }
     let edges = merge_edges(edges);
     for e in &edges {
@@ -118,4 +142,17 @@ pub fn diff_dot(plan: &PlanDiff, source: &str) -> String {
     );
     out.push_str("}\n");
     out
+}
+
+/// An `otherwise` note's label: its line, its jobs under it.
+fn note_label(line: &Line) -> String {
+    let mut label = html(&line.text);
+    if !line.jobs.is_empty() {
+        let _ = write!(
+            label,
+            "<BR/><FONT POINT-SIZE=\"8\">{}</FONT>",
+            html(&line.jobs)
+        );
+    }
+    label
 }

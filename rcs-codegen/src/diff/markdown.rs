@@ -21,10 +21,7 @@ fn code(s: &str) -> String {
 
 /// A row's content without its label: `S1 when x > 5 -> S2 { … }`.
 fn content(v: &Option<RowView>) -> String {
-    v.as_ref().map_or(String::new(), |v| {
-        let t = v.text();
-        code(t.split_once(": ").map_or(t.as_str(), |(_, rest)| rest))
-    })
+    v.as_ref().map_or(String::new(), |v| code(&v.content()))
 }
 
 /// The whole diff as markdown; `No semantic change.` when empty.
@@ -109,7 +106,13 @@ fn findings(out: &mut String, title: &str, list: &[Finding]) {
     }
     let _ = writeln!(out, "**{title}**\n");
     for f in list {
-        let _ = writeln!(out, "- `{}` {}: {}", f.code, code(&f.place()), cell(&f.message));
+        let _ = writeln!(
+            out,
+            "- `{}` {}: {}",
+            f.code,
+            code(&f.place()),
+            cell(&f.message)
+        );
     }
     out.push('\n');
 }

@@ -39,19 +39,31 @@ pub fn text(diff: &PlanSetDiff, color: bool) -> String {
     let paint = Paint(color);
     let mut out = String::new();
     for s in &diff.systems {
-        let _ = writeln!(out, "{}", paint.bold(&format!("system {}{}", s.name, presence(s.presence))));
+        let _ = writeln!(
+            out,
+            "{}",
+            paint.bold(&format!("system {}{}", s.name, presence(s.presence)))
+        );
         for i in &s.items {
             let (m, t) = item_line(i);
             let _ = writeln!(out, "  {}", paint.mark(m, &format!("{} {t}", i.kind)));
         }
         for c in &s.controllers {
-            let _ = writeln!(out, "  {}", paint.bold(&format!("controller {}{}", c.name, presence(c.presence))));
+            let _ = writeln!(
+                out,
+                "  {}",
+                paint.bold(&format!("controller {}{}", c.name, presence(c.presence)))
+            );
             for i in &c.items {
                 let (m, t) = item_line(i);
                 let _ = writeln!(out, "    {}", paint.mark(m, &t));
             }
             for p in &c.plans {
-                let _ = writeln!(out, "    {}", paint.bold(&format!("plan {}{}", p.name(), presence(p.presence))));
+                let _ = writeln!(
+                    out,
+                    "    {}",
+                    paint.bold(&format!("plan {}{}", p.name(), presence(p.presence)))
+                );
                 for st in &p.states_added {
                     let _ = writeln!(out, "      {}", paint.mark('+', &format!("state {st}")));
                 }
@@ -66,8 +78,20 @@ pub fn text(diff: &PlanSetDiff, color: bool) -> String {
                 }
             }
         }
-        findings(&mut out, &paint, "findings introduced", '+', &s.findings_introduced);
-        findings(&mut out, &paint, "findings removed", '-', &s.findings_removed);
+        findings(
+            &mut out,
+            &paint,
+            "findings introduced",
+            '+',
+            &s.findings_introduced,
+        );
+        findings(
+            &mut out,
+            &paint,
+            "findings removed",
+            '-',
+            &s.findings_removed,
+        );
     }
     out
 }

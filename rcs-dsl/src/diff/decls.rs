@@ -50,7 +50,10 @@ pub(super) fn system_items(old: &Ir, new: &Ir) -> Vec<ItemChange> {
             .iter()
             .map(|e| {
                 let vs: Vec<&str> = e.variants.iter().map(|v| v.name.as_str()).collect();
-                (e.name.clone(), format!("enum {} {{ {} }}", e.name, vs.join(", ")))
+                (
+                    e.name.clone(),
+                    format!("enum {} {{ {} }}", e.name, vs.join(", ")),
+                )
             })
             .collect()
     };
@@ -64,7 +67,10 @@ pub(super) fn system_items(old: &Ir, new: &Ir) -> Vec<ItemChange> {
                     .iter()
                     .map(|f| format!("{}: {}", f.name, type_name(ir, &f.ty)))
                     .collect();
-                (b.name.clone(), format!("buffer {} {{ {} }}", b.name, fs.join(", ")))
+                (
+                    b.name.clone(),
+                    format!("buffer {} {{ {} }}", b.name, fs.join(", ")),
+                )
             })
             .collect()
     };
@@ -77,7 +83,10 @@ pub(super) fn system_items(old: &Ir, new: &Ir) -> Vec<ItemChange> {
                     .writer
                     .map_or("external".to_string(), |w| ir.controller(w).name.clone());
                 let ty = &ir.buffer_types[b.ty.index()].name;
-                (b.name.clone(), format!("{}: {ty}, written by {writer}", b.name))
+                (
+                    b.name.clone(),
+                    format!("{}: {ty}, written by {writer}", b.name),
+                )
             })
             .collect()
     };
@@ -91,7 +100,12 @@ pub(super) fn system_items(old: &Ir, new: &Ir) -> Vec<ItemChange> {
                     .iter()
                     .map(|id| ir.controller(*id).name.as_str())
                     .collect();
-                let sig = format!("cpu {} every {} ns: {}", c.name, c.period_ns, order.join(", "));
+                let sig = format!(
+                    "cpu {} every {} ns: {}",
+                    c.name,
+                    c.period_ns,
+                    order.join(", ")
+                );
                 (c.name.clone(), sig)
             })
             .collect()
@@ -113,7 +127,12 @@ pub(super) fn controller_items(
         ("command", |ir, c| {
             c.commands
                 .iter()
-                .map(|x| (x.name.clone(), format!("command {}({})", x.name, params(ir, &x.params))))
+                .map(|x| {
+                    (
+                        x.name.clone(),
+                        format!("command {}({})", x.name, params(ir, &x.params)),
+                    )
+                })
                 .collect()
         }),
         ("status", |_, c| {

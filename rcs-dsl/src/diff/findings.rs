@@ -97,7 +97,7 @@ fn locate(ir: &Ir, d: &Diagnostic) -> Finding {
                     let v = RowView::of(ir, &Printer::new(ir, c, Some(p)), r);
                     f.row = Some(v.label.clone());
                     f.line = Some(v.line);
-                    row_content = v.text().split_once(": ").map_or(String::new(), |(_, t)| t.to_string());
+                    row_content = v.content();
                 }
             }
         }

@@ -152,10 +152,7 @@ impl PlanDiff {
 /// checks fail (a row made shadowed is an error by default) is still
 /// diffed — its IR lowered without the checks, their errors kept as
 /// findings; `None` only when it does not parse or lower.
-pub fn check_side(
-    set: &crate::PlanSet,
-    options: &crate::Options,
-) -> (Option<Ir>, Vec<Diagnostic>) {
+pub fn check_side(set: &crate::PlanSet, options: &crate::Options) -> (Option<Ir>, Vec<Diagnostic>) {
     let checked = crate::check(set, options);
     let ir = checked.ir.or_else(|| crate::lower_unchecked(set));
     (ir, checked.diagnostics)

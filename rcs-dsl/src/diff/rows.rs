@@ -89,14 +89,20 @@ impl RowView {
             && self.jobs == o.jobs
     }
 
-    /// `E3: S1 when cond -> S2 { jobs }`, one line.
+    /// `E3: S1 when cond -> S2 { jobs }` (`E10 otherwise -> same`), one line.
     pub fn text(&self) -> String {
-        let mut s = format!("{}: {}", self.label, self.from);
-        if self.otherwise {
-            s.push_str(" otherwise");
+        let sep = if self.otherwise { " " } else { ": " };
+        format!("{}{sep}{}", self.label, self.content())
+    }
+
+    /// The row without its label: `S1 when cond -> S2 { jobs }`
+    /// (`otherwise -> same`).
+    pub fn content(&self) -> String {
+        let mut s = if self.otherwise {
+            "otherwise".to_string()
         } else {
-            s.push_str(&format!(" when {}", self.condition));
-        }
+            format!("{} when {}", self.from, self.condition)
+        };
         s.push_str(&format!(" -> {}", self.target));
         if !self.jobs.is_empty() {
             s.push_str(&format!(" {{ {} }}", self.jobs.join("; ")));
@@ -128,7 +134,10 @@ pub struct RowDiff {
 impl RowDiff {
     /// Its label now (or before, when removed).
     pub fn label(&self) -> &str {
-        self.new.as_ref().or(self.old.as_ref()).map_or("", |v| &v.label)
+        self.new
+            .as_ref()
+            .or(self.old.as_ref())
+            .map_or("", |v| &v.label)
     }
 
     /// Both sides, with labels that differ: `E3` became `E4`.
@@ -219,8 +228,7 @@ pub(crate) fn diff_plan(old: Option<Side>, new: Option<Side>) -> PlanDiff {
     for (j, n) in nv.iter().enumerate() {
         let old_of = pairs.iter().find(|&&(_, b)| b == j).map(|&(a, _)| a);
         if let Some(a) = old_of {
-            let (before, after): (Vec<usize>, Vec<usize>) =
-                removed.iter().partition(|&&i| i < a);
+            let (before, after): (Vec<usize>, Vec<usize>) = removed.iter().partition(|&&i| i < a);
             for i in before {
                 rows.push(removed_row(&ov[i]));
             }

@@ -35,7 +35,9 @@ const BASE: &str = "        E0: *0 when new_command -> S1\n        E1: S1 when x
 
 #[test]
 fn whitespace_and_comments_are_no_change() {
-    let new = BASE.replace("x > 5", "( x   >  5 )").replace("-> Done\n", "-> Done // end\n");
+    let new = BASE
+        .replace("x > 5", "( x   >  5 )")
+        .replace("-> Done\n", "-> Done // end\n");
     let d = run(&plan(BASE), &plan(&new));
     assert!(d.is_empty(), "{d:#?}");
 }
@@ -81,7 +83,9 @@ fn an_inserted_row_renumbers_the_rest_without_changing_them() {
         "        E1: S1 when x > 10 -> Done\n",
         "        E1: S1 when x == 3 -> S2\n        E2: S1 when x > 10 -> Done\n",
     );
-    let new = new.replace("E2: S1 when x > 5", "E3: S1 when x > 5").replace("E3: S2", "E4: S2");
+    let new = new
+        .replace("E2: S1 when x > 5", "E3: S1 when x > 5")
+        .replace("E3: S2", "E4: S2");
     let d = run(&plan(BASE), &plan(&new));
     let p = &d.systems[0].controllers[0].plans[0];
     let kinds: Vec<(&str, &RowChange)> = p.rows.iter().map(|r| (r.label(), &r.change)).collect();

@@ -9,6 +9,9 @@
 //!    ──table─▶ tables/<CTRL>.md
 //! ```
 //!
+//! [`diff`] renders a semantic diff of two plan-set versions
+//! (`rcs_dsl::diff`) as text, markdown or diff-coloured DOT, for `rcsc diff`.
+//!
 //! Between generation and the writer, [`rustfmt`] formats the Rust files
 //! with the installed `rustfmt` (when there is one). The [`writer`] locks
 //! the output folder, stages every file and commits them through a

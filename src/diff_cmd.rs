@@ -134,11 +134,17 @@ fn sides(old: &str, new: Option<&str>, paths: &[PathBuf]) -> Result<(Where, Wher
             ));
         }
     }
-    let new = match new {
-        Some(n) => side(n)?,
-        None => Where::Paths(paths.to_vec()),
-    };
-    Ok((side(old)?, new))
+    let old = side(old)?;
+    let new =
+        match (new, &old) {
+            (Some(n), _) => side(n)?,
+            (None, Where::Rev(_)) => Where::Paths(paths.to_vec()),
+            (None, Where::Paths(_)) => return Err(
+                "OLD is a path: name NEW too (a revision alone is compared with the working tree)"
+                    .to_string(),
+            ),
+        };
+    Ok((old, new))
 }
 
 fn side(arg: &str) -> Result<Where, String> {

@@ -111,6 +111,31 @@ fn bad_sides_are_errors() {
         "{}",
         text(&out.stderr)
     );
+    let out = rcsc_in(Path::new("tests/data/diff/reordered"), &["diff", "old"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("name NEW too"),
+        "{}",
+        text(&out.stderr)
+    );
+    // A side that does not parse: its diagnostics, then exit status 2.
+    let dir = scratch(
+        "diff-broken",
+        &[("a/x.rcs", "controller {"), ("b/x.rcs", "controller {")],
+    );
+    let out = rcsc_in(&dir, &["diff", "a", "b"]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("error[syntax]"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(
+        text(&out.stderr).contains("does not parse"),
+        "{}",
+        text(&out.stderr)
+    );
 }
 
 fn git(dir: &Path, args: &[&str]) {

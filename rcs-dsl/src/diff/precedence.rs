@@ -11,6 +11,8 @@
 //! witness shows the input. When the analysis proves `b` never fires while
 //! `a` holds, in every shared state, the two rows do not compete and the
 //! flip is not reported; otherwise the move is reported as undecided.
+//! Plans the analysis does not take on ([`crate::analysis::MAX_ANALYSED`])
+//! get no moves at all: silent where it cannot decide.
 
 use super::rows::RowView;
 use crate::analysis::{covers, Answer, PlanAnalysis};
@@ -51,6 +53,11 @@ pub(crate) fn moves(
     let (ir, ctrl, plan) = new;
     let an = PlanAnalysis::new(ir, ctrl, plan);
     let mut out = Vec::new();
+    // A plan the analysis does not take on (far past the rule of ten)
+    // would give every flipped pair as undecided, quadratically many.
+    if !an.analysed() {
+        return out;
+    }
     for &(oa, na) in pairs {
         for &(ob, nb) in pairs {
             // a came first before, b comes first now.

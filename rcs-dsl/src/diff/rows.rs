@@ -26,6 +26,7 @@ use super::{precedence, PlanDiff, Presence};
 use crate::ir::{Controller, From, Ir, Plan, Row};
 use crate::pretty::Printer;
 use serde::Serialize;
+use std::collections::{BTreeMap, VecDeque};
 
 /// One row, as both renderers and the matching see it.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
@@ -80,13 +81,6 @@ impl RowView {
             t if t.starts_with("Error") => "Error".to_string(),
             t => t.to_string(),
         }
-    }
-
-    fn same_content(&self, o: &RowView) -> bool {
-        self.from == o.from
-            && self.condition == o.condition
-            && self.target == o.target
-            && self.jobs == o.jobs
     }
 
     /// `E3: S1 when cond -> S2 { jobs }` (`E10 otherwise -> same`), one line.
@@ -156,32 +150,40 @@ fn views(side: Option<Side>) -> Vec<RowView> {
     plan.rows.iter().map(|r| RowView::of(ir, &p, r)).collect()
 }
 
-/// The pairs (old index, new index) of matched rows.
+/// The pairs (old index, new index) of matched rows, in old order. Each
+/// pass indexes the new rows left by its key, so matching stays
+/// `n log n` on large plans.
 pub(crate) fn match_rows(old: &[RowView], new: &[RowView]) -> Vec<(usize, usize)> {
-    let passes: [fn(&RowView, &RowView) -> bool; 5] = [
-        |o, n| o.label == n.label && o.same_content(n),
-        |o, n| o.same_content(n),
-        |o, n| o.label == n.label,
-        |o, n| o.from == n.from && o.condition == n.condition,
-        |o, n| o.from == n.from && o.target == n.target && o.jobs == n.jobs,
+    type Key = fn(&RowView) -> String;
+    let passes: [Key; 5] = [
+        |v| format!("{}\u{0}{}", v.label, v.content()),
+        |v| v.content(),
+        |v| v.label.clone(),
+        |v| format!("{}\u{0}{}", v.from, v.condition),
+        |v| format!("{}\u{0}{}\u{0}{}", v.from, v.target, v.jobs.join("\u{0}")),
     ];
-    let mut pairs: Vec<(usize, usize)> = Vec::new();
-    for pass in passes {
+    let mut old_of: Vec<Option<usize>> = vec![None; new.len()];
+    let mut new_of: Vec<Option<usize>> = vec![None; old.len()];
+    for key in passes {
+        let mut free: BTreeMap<String, VecDeque<usize>> = BTreeMap::new();
+        for (j, n) in new.iter().enumerate().filter(|(j, _)| old_of[*j].is_none()) {
+            free.entry(key(n)).or_default().push_back(j);
+        }
         for (i, o) in old.iter().enumerate() {
-            if pairs.iter().any(|&(a, _)| a == i) {
+            if new_of[i].is_some() {
                 continue;
             }
-            let found = new
-                .iter()
-                .enumerate()
-                .find(|&(j, n)| !pairs.iter().any(|&(_, b)| b == j) && pass(o, n));
-            if let Some((j, _)) = found {
-                pairs.push((i, j));
+            if let Some(j) = free.get_mut(&key(o)).and_then(VecDeque::pop_front) {
+                new_of[i] = Some(j);
+                old_of[j] = Some(i);
             }
         }
     }
-    pairs.sort();
-    pairs
+    new_of
+        .iter()
+        .enumerate()
+        .filter_map(|(i, j)| j.map(|j| (i, j)))
+        .collect()
 }
 
 fn change(o: &RowView, n: &RowView) -> RowChange {
@@ -221,20 +223,23 @@ pub(crate) fn diff_plan(old: Option<Side>, new: Option<Side>) -> PlanDiff {
     let pairs = match_rows(&ov, &nv);
     let mut rows: Vec<RowDiff> = Vec::new();
     // New rows in order; each removed row goes before the first new row
-    // whose old counterpart came after it.
-    let mut removed: Vec<usize> = (0..ov.len())
-        .filter(|i| !pairs.iter().any(|&(a, _)| a == *i))
-        .collect();
+    // whose old counterpart came after it (`removed` stays sorted).
+    let mut old_of: Vec<Option<usize>> = vec![None; nv.len()];
+    let mut matched = vec![false; ov.len()];
+    for &(a, b) in &pairs {
+        old_of[b] = Some(a);
+        matched[a] = true;
+    }
+    let mut removed: std::collections::VecDeque<usize> =
+        (0..ov.len()).filter(|i| !matched[*i]).collect();
     for (j, n) in nv.iter().enumerate() {
-        let old_of = pairs.iter().find(|&&(_, b)| b == j).map(|&(a, _)| a);
-        if let Some(a) = old_of {
-            let (before, after): (Vec<usize>, Vec<usize>) = removed.iter().partition(|&&i| i < a);
-            for i in before {
+        if let Some(a) = old_of[j] {
+            while let Some(i) = removed.front().copied().filter(|&i| i < a) {
+                removed.pop_front();
                 rows.push(removed_row(&ov[i]));
             }
-            removed = after;
         }
-        rows.push(match old_of {
+        rows.push(match old_of[j] {
             Some(a) => RowDiff {
                 old: Some(ov[a].clone()),
                 new: Some(n.clone()),

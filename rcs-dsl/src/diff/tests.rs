@@ -102,3 +102,23 @@ fn an_inserted_row_renumbers_the_rest_without_changing_them() {
     assert!(p.rows[2].renumbered());
     assert!(p.moves.is_empty());
 }
+
+#[test]
+fn a_plan_past_the_analysis_limit_is_matched_but_gets_no_moves() {
+    let n = crate::analysis::MAX_ANALYSED + 50;
+    let rows = |order: &mut dyn Iterator<Item = usize>| -> String {
+        let mut s = "        E0: *0 when new_command -> S1\n".to_string();
+        for (pos, v) in order.enumerate() {
+            s.push_str(&format!("        E{}: S1 when x == {v} -> S1\n", pos + 1));
+        }
+        s
+    };
+    let old = rows(&mut (0..n));
+    let new = rows(&mut (0..n).rev());
+    let d = run(&plan(&old), &plan(&new));
+    let p = &d.systems[0].controllers[0].plans[0];
+    assert!(p.moves.is_empty());
+    assert_eq!(p.rows.len(), n + 1);
+    assert!(p.rows.iter().all(|r| r.change == RowChange::Same));
+    assert_eq!(p.rows.iter().filter(|r| r.renumbered()).count(), n - n % 2);
+}

@@ -102,40 +102,42 @@ fn json_names_the_move_and_its_witness() {
     );
 }
 
+/// `rcsc diff ARGS` in `dir` exits 2 saying each of `says` on stderr.
+fn fails_saying(dir: &Path, args: &[&str], says: &[&str]) {
+    let out = rcsc_in(dir, args);
+    assert_eq!(out.status.code(), Some(2), "{args:?}");
+    for s in says {
+        assert!(
+            text(&out.stderr).contains(s),
+            "{args:?}: {}",
+            text(&out.stderr)
+        );
+    }
+}
+
 #[test]
 fn bad_sides_are_errors() {
-    let out = rcsc_in(Path::new("."), &["diff", "no-such-revision-or-path"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(
-        text(&out.stderr).contains("neither a file or folder nor a git revision"),
-        "{}",
-        text(&out.stderr)
+    fails_saying(
+        Path::new("."),
+        &["diff", "no-such-revision-or-path"],
+        &["neither a file or folder nor a git revision"],
     );
-    let out = rcsc_in(Path::new("tests/data/diff/reordered"), &["diff", "old"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(
-        text(&out.stderr).contains("name NEW too"),
-        "{}",
-        text(&out.stderr)
+    fails_saying(
+        Path::new("tests/data/diff/reordered"),
+        &["diff", "old"],
+        &["name NEW too"],
     );
     // A side that does not parse: its diagnostics, then exit status 2.
     let dir = scratch(
         "diff-broken",
         &[("a/x.rcs", "controller {"), ("b/x.rcs", "controller {")],
     );
-    let out = rcsc_in(&dir, &["diff", "a", "b"]);
+    fails_saying(
+        &dir,
+        &["diff", "a", "b"],
+        &["error[syntax]", "does not parse"],
+    );
     let _ = std::fs::remove_dir_all(&dir);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(
-        text(&out.stderr).contains("error[syntax]"),
-        "{}",
-        text(&out.stderr)
-    );
-    assert!(
-        text(&out.stderr).contains("does not parse"),
-        "{}",
-        text(&out.stderr)
-    );
 }
 
 fn git(dir: &Path, args: &[&str]) {

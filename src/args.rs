@@ -41,6 +41,56 @@ pub(crate) enum Command {
     /// Run scenarios against the plans, on the interpreter or the generated code.
     #[command(after_help = TEST_HELP)]
     Test(TestArgs),
+    /// Compare two versions of plan sets (paths or git revisions), by meaning.
+    #[command(after_help = DIFF_HELP)]
+    Diff(DiffArgs),
+}
+
+const DIFF_HELP: &str = "\
+Each side is a plan-set path (as `rcsc check` takes) or a git revision of
+the repository of the current folder. `rcsc diff REV` compares REV with the
+working tree; `rcsc diff A..B` compares two revisions. In a revision, the
+plans are read at --path (default `.`), relative to the current folder.
+
+Per controller and plan it lists rows added, removed, changed (condition,
+target, jobs, compared after normalising: whitespace and comments are no
+change), renumbered, and moved in precedence (with an input for which the
+row that fires changes, when the analysis finds one); states added and
+removed; commands, statuses, errors, vars, hooks, buffers and subordinates
+changed; and the findings of `rcsc check` the change introduced or removed.
+
+Exit status: 0 no change, 1 changes, 2 an error.
+
+Examples:
+  rcsc diff HEAD~1 --path plans/submarine
+  rcsc diff main..feature --path plans --format markdown > comment.md
+  rcsc diff old/plans new/plans --graphs target/diff";
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum DiffFormat {
+    Text,
+    Markdown,
+    Json,
+}
+
+#[derive(Args)]
+pub(crate) struct DiffArgs {
+    /// The old version: a path or a git revision (`A..B`: both sides).
+    pub(crate) old: String,
+    /// The new version: a path or a git revision [default: the working tree]
+    pub(crate) new: Option<String>,
+    /// The plan sets to compare in a revision (and in the working tree),
+    /// relative to the current folder [default: .]
+    #[arg(short = 'p', long = "path", value_name = "PATH")]
+    pub(crate) paths: Vec<PathBuf>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = DiffFormat::Text)]
+    pub(crate) format: DiffFormat,
+    /// Also write a diff-coloured DOT graph per changed plan under DIR.
+    #[arg(long, value_name = "DIR")]
+    pub(crate) graphs: Option<PathBuf>,
+    #[command(flatten)]
+    pub(crate) common: Common,
 }
 
 const TEST_HELP: &str = "\

@@ -9,6 +9,7 @@ use std::process::ExitCode;
 mod args;
 mod commands;
 mod compiled;
+mod diff_cmd;
 mod output;
 mod test_cmd;
 mod witnesses;
@@ -25,6 +26,7 @@ fn main() -> ExitCode {
         Command::Graph(args) => graph(args),
         Command::Ir(args) => ir(args),
         Command::Test(args) => test_cmd::test(args),
+        Command::Diff(args) => diff_cmd::diff(args),
     }
 }
 

@@ -3,17 +3,27 @@
 //!
 //! Notation (Figure 13, Appendix C): states are circles, `Done` a double
 //! circle, `Error` a red octagon; each don't-care row gets its own dashed
-//! `*N` pseudo-node with an edge to its target; edges read `EN: condition`
-//! with the job list in a smaller second line; `otherwise` is dashed; a
-//! `same` edge loops. Nodes and edges appear in the order of the rows.
+//! `*N` pseudo-node with an edge to its target. Rows between the same two
+//! nodes (several self-loops on one state, say) are **one edge** whose
+//! label lists them, one line per row (`EN: condition`, its jobs in a
+//! smaller line under it), and a loop of several rows hangs below its
+//! state with its label under it, so no arc crosses a label; an edge's label is
+//! tied to its arc (`decorate`) where several edges enter one node, so a
+//! fan-in label cannot be read as another edge's. The `otherwise` row is
+//! not an edge of any state: it is a dashed note, `EN otherwise`, saying
+//! what happens in any state when no row matches (an edge from the note
+//! when it leaves the state). Nodes appear in the order of the rows.
+//!
+//! [`Edge`] and [`edge_attrs`] are shared with the diff graphs
+//! (`crate::diff_dot`), which colour each line by what a change did to it.
 
 use crate::GENERATED;
-use rcs_dsl::ir::{Controller, From, Ir, Plan, Target};
+use rcs_dsl::ir::{Controller, From, Ir, Plan, Row, Target};
 use rcs_dsl::pretty::Printer;
 use std::fmt::Write;
 
 /// Escape text for a Graphviz HTML-like label.
-fn html(s: &str) -> String {
+pub(crate) fn html(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
         match c {
@@ -29,7 +39,7 @@ fn html(s: &str) -> String {
 }
 
 /// Escape text for a quoted DOT string.
-fn quoted(s: &str) -> String {
+pub(crate) fn quoted(s: &str) -> String {
     let mut out = String::with_capacity(s.len() + 2);
     out.push('"');
     for c in s.chars() {
@@ -44,8 +54,164 @@ fn quoted(s: &str) -> String {
     out
 }
 
-fn header(out: &mut String, source: &str) {
+pub(crate) fn header(out: &mut String, source: &str) {
     let _ = writeln!(out, "// {GENERATED} from {source}. Do not edit.");
+}
+
+/// One row as a line of an edge label.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Line {
+    /// `E2: TB.done && x > 1`.
+    pub(crate) text: String,
+    /// The job list, `;`-separated; empty for none.
+    pub(crate) jobs: String,
+    /// Where the row is, or its doc comment.
+    pub(crate) tooltip: String,
+    /// A font colour for the line (diff graphs); `None`: the default.
+    pub(crate) color: Option<&'static str>,
+}
+
+/// All the rows from one node to another, drawn as one edge.
+#[derive(Clone, Debug)]
+pub(crate) struct Edge {
+    pub(crate) from: String,
+    pub(crate) to: String,
+    pub(crate) lines: Vec<Line>,
+}
+
+/// Rows as (from, to, line) → one edge per node pair, in order of first
+/// appearance, its lines in row order.
+pub(crate) fn merge_edges(rows: impl IntoIterator<Item = (String, String, Line)>) -> Vec<Edge> {
+    let mut edges: Vec<Edge> = Vec::new();
+    for (from, to, line) in rows {
+        match edges.iter_mut().find(|e| e.from == from && e.to == to) {
+            Some(e) => e.lines.push(line),
+            None => edges.push(Edge {
+                from,
+                to,
+                lines: vec![line],
+            }),
+        }
+    }
+    edges
+}
+
+/// The attributes of an edge: its label (one left-aligned line per row,
+/// the jobs in a smaller line under it) and tooltip; `decorate` ties the
+/// label to its arc when other edges enter the same node.
+fn edge_attrs(edge: &Edge, all: &[Edge]) -> String {
+    let mut label = String::new();
+    // One row: its line, its jobs centred under it. Several: every line
+    // left-aligned, the jobs indented under their row.
+    let (br, indent) = match edge.lines.len() {
+        1 => ("<BR/>", ""),
+        _ => ("<BR ALIGN=\"LEFT\"/>", "   "),
+    };
+    for line in &edge.lines {
+        let (open, close) = match line.color {
+            Some(c) => (format!("<FONT COLOR=\"{c}\">"), "</FONT>"),
+            None => (String::new(), ""),
+        };
+        let _ = write!(label, "{open}{}{close}", html(&line.text));
+        if !line.jobs.is_empty() {
+            let _ = write!(
+                label,
+                "{br}<FONT POINT-SIZE=\"8\">{open}{indent}{}{close}</FONT>",
+                html(&line.jobs)
+            );
+        }
+        if edge.lines.len() > 1 {
+            label.push_str(br);
+        }
+    }
+    let tips: Vec<&str> = edge.lines.iter().map(|l| l.tooltip.as_str()).collect();
+    let mut attrs = format!("label=<{label}>, tooltip={}", quoted(&tips.join("\n")));
+    let fan_in = all
+        .iter()
+        .filter(|e| e.to == edge.to && e.from != e.to)
+        .count();
+    if edge.from != edge.to && fan_in > 1 {
+        attrs.push_str(", decorate=true");
+    }
+    attrs
+}
+
+/// The node a row leaves from: its state, or its own `*N` pseudo-node.
+pub(crate) fn from_node(p: &Printer, r: &Row) -> String {
+    match r.from {
+        From::DontCare(_) => format!("*{}", r.position),
+        From::State(s) => p.state(s),
+    }
+}
+
+/// The node a row goes to (`same`: where it left from).
+pub(crate) fn to_node(p: &Printer, r: &Row) -> String {
+    match r.to {
+        Target::Same => from_node(p, r),
+        Target::State(_) => p.target(r),
+        Target::Done => "Done".to_string(),
+        Target::Error(_) => "Error".to_string(),
+    }
+}
+
+/// A row's line: `E2: condition` (`→ Error(E)` added when it names one).
+pub(crate) fn row_line(ir: &Ir, p: &Printer, r: &Row) -> Line {
+    let mut text = format!("{}: {}", p.label(r), p.condition(r));
+    if let Target::Error(Some(_)) = r.to {
+        text.push_str(&format!(" → {}", p.target(r)));
+    }
+    let jobs: Vec<String> = r.jobs.iter().map(|j| p.job(j)).collect();
+    Line {
+        text,
+        jobs: jobs.join("; "),
+        tooltip: tooltip(ir, r),
+        color: None,
+    }
+}
+
+fn tooltip(ir: &Ir, r: &Row) -> String {
+    if r.docs.is_empty() {
+        format!("{}:{}", ir.files[r.span.file.0 as usize], r.line)
+    } else {
+        r.docs.join("\n")
+    }
+}
+
+/// The name of the `otherwise` note: `E10 otherwise`, as the tables and
+/// diagnostics name the row.
+pub fn otherwise_name(r: &Row) -> String {
+    format!("{} otherwise", r.display_name())
+}
+
+/// The label of the `otherwise` note: what it does, in any state.
+pub(crate) fn otherwise_label(p: &Printer, r: &Row) -> String {
+    let mut label = format!(
+        "{}<BR/><FONT POINT-SIZE=\"8\">any state, no row matched",
+        html(&otherwise_name(r))
+    );
+    if matches!(r.to, Target::Same) {
+        label.push_str(": stay");
+    }
+    label.push_str("</FONT>");
+    if !r.jobs.is_empty() {
+        let jobs: Vec<String> = r.jobs.iter().map(|j| p.job(j)).collect();
+        let _ = write!(
+            label,
+            "<BR/><FONT POINT-SIZE=\"8\">{}</FONT>",
+            html(&jobs.join("; "))
+        );
+    }
+    label
+}
+
+/// The attributes of a node that is not a plain state.
+pub(crate) fn node_attrs(id: &str) -> String {
+    match id {
+        "Done" => "shape=doublecircle".to_string(),
+        "Error" => "shape=octagon, color=red, fontcolor=red".to_string(),
+        _ if id.starts_with('*') => format!("label={}, style=dashed", quoted(id)),
+        _ => String::new(),
+    }
 }
 
 /// The state graph of one plan.
@@ -55,98 +221,83 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
     let source = &ir.files[plan.header.file.0 as usize];
     let mut out = String::new();
     header(&mut out, source);
-    let _ = writeln!(
-        out,
-        "digraph {} {{",
-        quoted(&format!("{}.{verb}", ctrl.name))
-    );
-    let title = format!("{} · {verb}", ctrl.name);
-    let _ = writeln!(
-        out,
-        "    graph [label={}, labelloc=t, rankdir=LR, fontname=\"Helvetica\", tooltip={}];",
-        quoted(&title),
-        quoted(&plan.docs.join("\n"))
-    );
-    out.push_str("    node [fontname=\"Helvetica\", shape=circle];\n");
-    out.push_str("    edge [fontname=\"Helvetica\", fontsize=10];\n");
+    graph_head(&mut out, &format!("{}.{verb}", ctrl.name), &plan.docs);
 
     // Nodes in order of first appearance in the rows.
     let mut emitted: Vec<String> = Vec::new();
-    let mut node = |out: &mut String, id: String, attrs: String| {
+    let mut node = |out: &mut String, id: String| {
         if !emitted.contains(&id) {
-            let _ = writeln!(out, "    {} [{attrs}];", quoted(&id));
+            let _ = writeln!(out, "    {} [{}];", quoted(&id), node_attrs(&id));
             emitted.push(id);
         }
     };
+    let mut edges = Vec::new();
     for r in &plan.rows {
-        let from = from_node(&p, r);
-        match r.from {
-            From::DontCare(_) => node(
-                &mut out,
-                from.clone(),
-                format!("label={}, style=dashed", quoted(&from)),
-            ),
-            From::State(_) => node(&mut out, from.clone(), String::new()),
-        }
-        match r.to {
-            Target::Same => {}
-            Target::State(_) => node(&mut out, p.target(r), String::new()),
-            Target::Done => node(
-                &mut out,
-                "Done".to_string(),
-                "shape=doublecircle".to_string(),
-            ),
-            Target::Error(_) => node(
-                &mut out,
-                "Error".to_string(),
-                "shape=octagon, color=red, fontcolor=red".to_string(),
-            ),
-        }
-    }
-    for r in &plan.rows {
-        let from = from_node(&p, r);
-        let to = match r.to {
-            Target::Same => from.clone(),
-            Target::State(_) => p.target(r),
-            Target::Done => "Done".to_string(),
-            Target::Error(_) => "Error".to_string(),
-        };
-        let mut label = format!("{}: {}", p.label(r), p.condition(r));
-        if let Target::Error(Some(_)) = r.to {
-            label.push_str(&format!(" → {}", p.target(r)));
-        }
-        let mut html_label = html(&label);
-        if !r.jobs.is_empty() {
-            let jobs: Vec<String> = r.jobs.iter().map(|j| p.job(j)).collect();
-            let _ = write!(
-                html_label,
-                "<BR/><FONT POINT-SIZE=\"8\">{}</FONT>",
-                html(&jobs.join("; "))
-            );
-        }
-        let mut attrs = format!("label=<{html_label}>");
         if r.is_otherwise() {
-            attrs.push_str(", style=dashed");
+            let note = otherwise_name(r);
+            let _ = writeln!(
+                out,
+                "    {} [label=<{}>, shape=note, style=dashed, tooltip={}];",
+                quoted(&note),
+                otherwise_label(&p, r),
+                quoted(&tooltip(ir, r))
+            );
+            if !matches!(r.to, Target::Same) {
+                node(&mut out, to_node(&p, r));
+                let _ = writeln!(
+                    out,
+                    "    {} -> {} [style=dashed];",
+                    quoted(&note),
+                    quoted(&to_node(&p, r))
+                );
+            }
+            continue;
         }
-        let tip = if r.docs.is_empty() {
-            format!("{}:{}", ir.files[r.span.file.0 as usize], r.line)
-        } else {
-            r.docs.join("\n")
-        };
-        let _ = write!(attrs, ", tooltip={}", quoted(&tip));
-        let _ = writeln!(out, "    {} -> {} [{attrs}];", quoted(&from), quoted(&to));
+        node(&mut out, from_node(&p, r));
+        node(&mut out, to_node(&p, r));
+        edges.push((from_node(&p, r), to_node(&p, r), row_line(ir, &p, r)));
+    }
+    let edges = merge_edges(edges);
+    for e in &edges {
+        write_edge(&mut out, e, &edges, "");
     }
     out.push_str("}\n");
     out
 }
 
-fn from_node(p: &Printer, r: &rcs_dsl::ir::Row) -> String {
-    match r.from {
-        From::DontCare(_) => format!("*{}", r.position),
-        From::State(s) => p.state(s),
-    }
+/// One edge. A self-loop of several rows hangs below its node (`:s`
+/// ports), where its label sits under the arc: in the default place, with
+/// `rankdir=LR`, Graphviz lets the arc run through a label of many lines.
+/// A loop of one row keeps the default place, which leaves more room.
+/// `extra` attributes follow the label's (`, color=red`).
+pub(crate) fn write_edge(out: &mut String, e: &Edge, all: &[Edge], extra: &str) {
+    let port = if e.from == e.to && e.lines.len() > 1 {
+        ":s"
+    } else {
+        ""
+    };
+    let _ = writeln!(
+        out,
+        "    {}{port} -> {}{port} [{}{extra}];",
+        quoted(&e.from),
+        quoted(&e.to),
+        edge_attrs(e, all)
+    );
 }
 
+/// `digraph NAME {` and the graph, node and edge defaults.
+pub(crate) fn graph_head(out: &mut String, name: &str, docs: &[String]) {
+    let _ = writeln!(out, "digraph {} {{", quoted(name));
+    let title = name.replacen('.', " · ", 1);
+    let _ = writeln!(
+        out,
+        "    graph [label={}, labelloc=t, rankdir=LR, fontname=\"Helvetica\", tooltip={}];",
+        quoted(&title),
+        quoted(&docs.join("\n"))
+    );
+    out.push_str("    node [fontname=\"Helvetica\", shape=circle];\n");
+    out.push_str("    edge [fontname=\"Helvetica\", fontsize=10];\n");
+}
 /// The controller tree, one cluster per executive ("CPU").
 pub fn hierarchy_graph(ir: &Ir) -> String {
     let mut out = String::new();

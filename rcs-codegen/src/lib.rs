@@ -9,6 +9,9 @@
 //!    ──table─▶ tables/<CTRL>.md
 //! ```
 //!
+//! [`diff`] renders a semantic diff of two plan-set versions
+//! (`rcs_dsl::diff`) as text, markdown or diff-coloured DOT, for `rcsc diff`.
+//!
 //! Between generation and the writer, [`rustfmt`] formats the Rust files
 //! with the installed `rustfmt` (when there is one). The [`writer`] locks
 //! the output folder, stages every file and commits them through a
@@ -16,6 +19,7 @@
 //! over a file rcsc did not generate (see its docs for what it promises).
 
 pub mod config;
+pub mod diff;
 pub mod dot;
 pub mod ident;
 pub mod rust;

@@ -1,6 +1,9 @@
 //! IR → Markdown state tables, one file per controller with one table per
 //! plan, in Appendix C's layout: Row | IF event | current state | THEN next
-//! state | job list. A pure function returning a string.
+//! state | job list, and a last column with the rows' doc comments when
+//! any row of the plan has one. The `otherwise` row reads `E10 otherwise`
+//! as in the graphs: condition `otherwise`, current state `any`. A pure
+//! function returning a string.
 
 use crate::GENERATED;
 use rcs_dsl::ir::{Controller, Ir, Target};
@@ -75,19 +78,26 @@ pub fn controller_tables(ir: &Ir, ctrl: &Controller) -> String {
                     .join("\n")
             );
         }
-        out.push_str("| Row | IF (event) | current state | THEN next state | job list |\n");
-        out.push_str("|---|---|---|---|---|\n");
+        let notes = plan.rows.iter().any(|r| !r.docs.is_empty());
+        out.push_str("| Row | IF (event) | current state | THEN next state | job list |");
+        out.push_str(if notes { " notes |\n" } else { "\n" });
+        out.push_str("|---|---|---|---|---|");
+        out.push_str(if notes { "---|\n" } else { "\n" });
         for r in &plan.rows {
+            let from = if r.is_otherwise() {
+                "any".to_string()
+            } else {
+                p.from(r)
+            };
             let next = match r.to {
-                Target::Same => format!(
-                    "{} (same)",
-                    if r.is_dont_care() {
-                        "—".to_string()
-                    } else {
-                        p.from(r)
-                    }
-                ),
+                Target::Same if r.is_dont_care() => "same".to_string(),
+                Target::Same => format!("{from} (same)"),
                 _ => p.target(r),
+            };
+            let row = if r.is_otherwise() {
+                crate::dot::otherwise_name(r)
+            } else {
+                p.label(r)
             };
             let mut jobs: Vec<String> = r.jobs.iter().map(|j| code(&p.job(j))).collect();
             match r.to {
@@ -95,19 +105,20 @@ pub fn controller_tables(ir: &Ir, ctrl: &Controller) -> String {
                 Target::Error(_) => jobs.push("status ERROR".to_string()),
                 _ => {}
             }
-            let _ = writeln!(
+            let _ = write!(
                 out,
-                "| {} | {} | {} | {} | {} |",
-                p.label(r),
+                "| {row} | {} | {from} | {next} | {} |",
                 code(&p.condition(r)),
-                p.from(r),
-                next,
                 if jobs.is_empty() {
                     "—".to_string()
                 } else {
                     jobs.join("<br>")
                 }
             );
+            if notes {
+                let _ = write!(out, " {} |", cell(&r.docs.join(" ")));
+            }
+            out.push('\n');
         }
         out.push('\n');
     }

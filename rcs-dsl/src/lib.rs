@@ -25,6 +25,7 @@ pub mod arith;
 pub mod ast;
 mod checks;
 pub mod diagnostic;
+pub mod diff;
 pub mod interp;
 pub mod ir;
 pub mod lint;

@@ -32,6 +32,17 @@ pub enum Item {
     Enum(EnumDef),
     Buffer(BufferDef),
     Controller(ControllerDef),
+    /// `const NAME: TYPE = EXPR` at file level.
+    Const(ConstDef),
+}
+
+/// `const NAME: TYPE = EXPR`, at file or controller level.
+#[derive(Clone, Debug)]
+pub struct ConstDef {
+    pub name: Name,
+    pub ty: TypeExpr,
+    pub value: Expr,
+    pub span: Span,
 }
 
 #[derive(Clone, Debug)]
@@ -64,6 +75,8 @@ pub enum TypeExpr {
         elem: Box<TypeExpr>,
         len: u64,
         span: Span,
+        /// A length written as a constant expression (`len` is then 0).
+        len_expr: Option<Box<Expr>>,
     },
 }
 
@@ -114,6 +127,8 @@ pub enum EntryKind {
         ret: Option<TypeExpr>,
     },
     Plan(PlanDef),
+    /// `const NAME: TYPE = EXPR` in a controller.
+    Const(ConstDef),
 }
 
 #[derive(Clone, Debug)]

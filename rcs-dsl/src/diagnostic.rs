@@ -53,12 +53,15 @@ pub enum Code {
     LooseFile,
     TooLarge,
     CaseCollision,
+    NotConstant,
+    ConstCycle,
+    ReservedName,
     Lint(Lint),
 }
 
 impl Code {
     /// Every hard-error code, in catalogue order (lints follow in [`Lint::ALL`]).
-    pub const ERRORS: [Code; 23] = [
+    pub const ERRORS: [Code; 26] = [
         Code::Syntax,
         Code::DuplicateDefinition,
         Code::UnknownName,
@@ -82,6 +85,9 @@ impl Code {
         Code::LooseFile,
         Code::TooLarge,
         Code::CaseCollision,
+        Code::NotConstant,
+        Code::ConstCycle,
+        Code::ReservedName,
     ];
 
     pub fn name(self) -> &'static str {
@@ -109,6 +115,9 @@ impl Code {
             Code::LooseFile => "loose_file",
             Code::TooLarge => "too_large",
             Code::CaseCollision => "case_collision",
+            Code::NotConstant => "not_constant",
+            Code::ConstCycle => "const_cycle",
+            Code::ReservedName => "reserved_name",
             Code::Lint(l) => l.name(),
         }
     }
@@ -143,6 +152,9 @@ impl Code {
             Code::CaseCollision => {
                 "two names differ only in case where they become one output file name"
             }
+            Code::NotConstant => "a `const` or an array length is not a constant expression",
+            Code::ConstCycle => "constants are defined in terms of each other",
+            Code::ReservedName => "a declaration takes the name of a built-in function",
             Code::Lint(Lint::RuleOfTen) => "a plan has more rows than the rule of ten allows",
             Code::Lint(Lint::ShadowedRow) => "earlier rows always match before this row",
             Code::Lint(Lint::UnreachableState) => "no path from the entry reaches a state",

@@ -488,6 +488,11 @@ impl<'ir> Interpreter<'ir> {
                 crate::arith::cast(v, &e.ty)
             }
             ExprKind::Binary(op, l, r) => self.binary(*op, l, r, &e.ty, hooks),
+            ExprKind::Builtin(b, args) => {
+                let values: Vec<Value> = args.iter().map(|a| self.eval(a, hooks)).collect();
+                let ty = args.first().map_or(&e.ty, |a| &a.ty);
+                crate::builtin::apply(*b, &values, ty)
+            }
         }
     }
 

@@ -500,6 +500,9 @@ pub enum ExprKind {
     Unary(UnOp, Box<Expr>),
     Binary(BinOp, Box<Expr>, Box<Expr>),
     Cast(Box<Expr>),
+    /// A built-in function (`abs`, `sqrt`, …): pure, arguments of one type
+    /// (see [`crate::builtin`]).
+    Builtin(crate::builtin::Builtin, Vec<Expr>),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -571,7 +574,9 @@ impl Expr {
                 l.visit(f);
                 r.visit(f);
             }
-            ExprKind::Call(_, args) => args.iter().for_each(|a| a.visit(f)),
+            ExprKind::Call(_, args) | ExprKind::Builtin(_, args) => {
+                args.iter().for_each(|a| a.visit(f))
+            }
             _ => {}
         }
     }

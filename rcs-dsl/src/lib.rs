@@ -23,6 +23,7 @@ extern crate alloc;
 pub mod analysis;
 pub mod arith;
 pub mod ast;
+pub mod builtin;
 mod checks;
 pub mod diagnostic;
 pub mod diff;

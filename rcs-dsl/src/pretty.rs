@@ -78,8 +78,12 @@ impl<'a> Printer<'a> {
                 self.write(base, ATOM, out);
                 out.push_str(&format!("[{i}]"));
             }
-            ExprKind::Call(h, args) => {
-                out.push_str(&self.ctrl.hooks[h.index()].name);
+            ExprKind::Call(_, args) | ExprKind::Builtin(_, args) => {
+                out.push_str(match &e.kind {
+                    ExprKind::Call(h, _) => &self.ctrl.hooks[h.index()].name,
+                    ExprKind::Builtin(b, _) => b.name(),
+                    _ => unreachable!("a call"),
+                });
                 out.push('(');
                 for (i, a) in args.iter().enumerate() {
                     if i > 0 {

@@ -14,6 +14,7 @@
 //! | [`handshake`] | [`CommandBuffer`], [`StatusBuffer`], serials, [`SubordinateLink`] / [`Subordinate`] (a supervisor's view of a subordinate) |
 //! | [`plan`] | [`Bookkeeping`]: new-command detection, state, status, counters, fired row, per-verb durations |
 //! | [`exec`] | [`Controller`], [`Executive`] (the main program), [`Heartbeat`], pause/step/go through [`ExecutiveHandle`] |
+//! | [`math`] | the float built-in functions of the language (`sqrt`, `min`, …), shared by generated code and the interpreter |
 //! | [`operator`] | [`Operator`]: command a root controller, read status |
 //! | [`trace`] | optional JSON-lines trace of every controller's cycle |
 //! | `seqlock` | the only `unsafe` code: the sequence lock behind Global Memory |
@@ -182,6 +183,7 @@ pub mod error;
 pub mod exec;
 pub mod gm;
 pub mod handshake;
+pub mod math;
 pub mod operator;
 pub mod plan;
 mod seqlock;

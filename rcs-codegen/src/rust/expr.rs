@@ -30,6 +30,17 @@ pub(crate) struct Code {
 }
 
 impl Code {
+    pub(crate) const ATOM: u8 = ATOM;
+    pub(crate) const CAST: u8 = CAST;
+
+    pub(crate) fn new(ts: TokenStream, prec: u8, has_block: bool) -> Code {
+        Code {
+            ts,
+            prec,
+            has_block,
+        }
+    }
+
     fn atom(ts: TokenStream) -> Code {
         Code {
             ts,
@@ -111,6 +122,7 @@ fn collect_calls(e: &Expr, f: &mut dyn FnMut(HookId, &[Expr])) {
             args.iter().for_each(|a| collect_calls(a, f));
             f(*h, args);
         }
+        ExprKind::Builtin(_, args) => args.iter().for_each(|a| collect_calls(a, f)),
         _ => {}
     }
 }
@@ -337,6 +349,11 @@ impl Gen<'_> {
                 }
             }
             ExprKind::Binary(op, l, r) => self.binary(*op, l, r),
+            ExprKind::Builtin(b, args) => {
+                let codes: Vec<Code> = args.iter().map(|a| self.expr(a)).collect();
+                let ty = args.first().map_or(&e.ty, |a| &a.ty);
+                super::builtins::call(*b, ty, &codes)
+            }
         }
     }
 

@@ -42,6 +42,14 @@ pub fn eval(e: &Expr, leaf: &dyn Fn(&Leaf) -> Option<Value>) -> Option<Value> {
         ExprKind::Unary(op, x) => arith::unary(*op, eval(x, leaf)?, &e.ty),
         ExprKind::Cast(x) => arith::cast(eval(x, leaf)?, &e.ty),
         ExprKind::Binary(op, l, r) => arith::binary(*op, eval(l, leaf)?, eval(r, leaf)?, &e.ty),
+        ExprKind::Builtin(b, args) => {
+            let values = args
+                .iter()
+                .map(|a| eval(a, leaf))
+                .collect::<Option<Vec<Value>>>()?;
+            let ty = args.first().map_or(&e.ty, |a| &a.ty);
+            crate::builtin::apply(*b, &values, ty)
+        }
         // Every other kind is a leaf (handled above).
         _ => return None,
     })

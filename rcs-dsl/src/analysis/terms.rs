@@ -186,6 +186,11 @@ impl Terms {
                 self.collect_leaves(l, out, scalar);
                 self.collect_leaves(r, out, scalar);
             }
+            // A built-in call is opaque: an atom reading one never counts
+            // as exact (see `exact`), whatever its arguments read.
+            ExprKind::Builtin(_, args) => args
+                .iter()
+                .for_each(|a| self.collect_leaves(a, out, scalar)),
             _ => {}
         }
     }

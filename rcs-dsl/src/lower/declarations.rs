@@ -3,7 +3,7 @@
 //! var initialisers and lowers the plans (through `lower::plans`).
 
 use super::expr::Cx;
-use super::{duplicate, resolve_type, ByName, Globals};
+use super::{duplicate, resolve_type, resolve_type_in, ByName, Globals};
 use crate::ast;
 use crate::diagnostic::{Code, Diagnostic, Diagnostics};
 use crate::ir::*;
@@ -12,6 +12,7 @@ use crate::source::Span;
 /// Pass 1 for every controller: commands, statuses, errors, vars, hooks.
 pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnostics) {
     for (i, c) in g.controllers.iter().enumerate() {
+        g.scope.set(Some(i));
         let mut commands: Vec<Command> = Vec::new();
         let mut statuses = std::mem::take(&mut ir.controllers[i].statuses);
         let mut errors: Vec<ErrorDef> = Vec::new();
@@ -37,6 +38,21 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
             }
         }
         let mut claim = |name: &ast::Name, what: &str, diags: &mut Diagnostics| -> bool {
+            if let Some(d) = super::consts::reserved(name) {
+                diags.push(d);
+            }
+            if g.consts_table.is_file_const(&name.text) {
+                diags.push(
+                    Diagnostic::error(
+                        Code::DuplicateDefinition,
+                        format!("`{}` is already a file-level constant", name.text),
+                        name.span,
+                        "would shadow the constant",
+                    )
+                    .with_help("names of a controller do not shadow file-level constants; rename one of them"),
+                );
+                return false;
+            }
             let found = value_names.first_or_insert(&name.text, values.len());
             if let Some((_, first)) = found.map(|k| &values[k]) {
                 // `reads`, `writes` and `subordinates` were collected first;
@@ -140,9 +156,18 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                         span: name.span,
                     });
                 }
+                ast::EntryKind::Const(k) => {
+                    claim(&k.name, "name", diags);
+                }
+                ast::EntryKind::Reads(n, _) | ast::EntryKind::Writes(n, _) => {
+                    if let Some(d) = super::consts::reserved(n) {
+                        diags.push(d);
+                    }
+                }
                 _ => {}
             }
         }
+        g.scope.set(None);
         let ctrl = &mut ir.controllers[i];
         ctrl.commands = commands;
         ctrl.statuses = statuses;
@@ -192,7 +217,7 @@ pub(super) fn lower_controller_body(
             .filter_map(|e| match &e.kind {
                 ast::EntryKind::Hook {
                     name, ret: Some(t), ..
-                } if resolve_type(g, t, &mut Diagnostics::new()).is_none() => {
+                } if resolve_type_in(g, Some(id.index()), t, &mut Diagnostics::new()).is_none() => {
                     Some(name.text.to_string())
                 }
                 _ => None,

@@ -7,6 +7,7 @@
 //! No cascades: a name that does not resolve is reported once, and the
 //! expression it stood in gets an error type that fits everywhere.
 
+pub(crate) mod consts;
 mod declarations;
 mod expr;
 mod index;
@@ -35,6 +36,34 @@ pub(crate) struct Globals<'a> {
     pub enums: Vec<&'a ast::EnumDef>,
     pub buffers: Vec<&'a ast::BufferDef>,
     pub controllers: Vec<&'a ast::ControllerDef>,
+    /// File-level `const` definitions, first of each name.
+    pub consts: Vec<&'a ast::ConstDef>,
+    /// Every constant's value, once folded (right after the enums).
+    pub consts_table: consts::ConstTable,
+    /// The controller whose declarations are being lowered, if any: the
+    /// scope of constants in array lengths. Set only by the sequential
+    /// passes; controller bodies, lowered in parallel, name their scope
+    /// ([`resolve_type_in`]).
+    pub scope: ScopeCell,
+}
+
+/// An `Option<usize>` that can be shared with the threads lowering
+/// controller bodies (which only ever read other fields of [`Globals`]).
+#[derive(Default)]
+pub(crate) struct ScopeCell(std::sync::atomic::AtomicUsize);
+
+impl ScopeCell {
+    pub fn get(&self) -> Option<usize> {
+        match self.0.load(std::sync::atomic::Ordering::Relaxed) {
+            0 => None,
+            n => Some(n - 1),
+        }
+    }
+
+    pub fn set(&self, scope: Option<usize>) {
+        let n = scope.map_or(0, |i| i + 1);
+        self.0.store(n, std::sync::atomic::Ordering::Relaxed);
+    }
 }
 
 pub(crate) const PRIMITIVES: [&str; 11] = [
@@ -51,7 +80,7 @@ pub fn lower(
     diags: &mut Diagnostics,
 ) -> Option<Ir> {
     let start = diags.len();
-    let globals = collect_items(files, diags);
+    let mut globals = collect_items(files, diags);
     let mut ir = Ir {
         system: system.to_string(),
         files: file_names,
@@ -63,6 +92,7 @@ pub fn lower(
         schedule: Vec::new(),
     };
     lower_enums(&globals, &mut ir, diags);
+    globals.consts_table = consts::fold_all(&globals, diags);
     lower_buffer_types(&globals, &mut ir, diags);
     check_buffer_recursion(&ir, diags);
     let ctrl_asts = lower_controller_headers(&globals, &mut ir, sources, diags);
@@ -170,9 +200,24 @@ fn collect_items<'a>(files: &'a [ast::File], diags: &mut Diagnostics) -> Globals
         enums: Vec::new(),
         buffers: Vec::new(),
         controllers: Vec::new(),
+        consts: Vec::new(),
+        consts_table: consts::ConstTable::default(),
+        scope: ScopeCell::default(),
     };
+    let mut const_names = ByName::default();
     for item in files.iter().flat_map(|f| &f.items) {
+        if let Some(d) = item_name(item).and_then(consts::reserved) {
+            diags.push(d);
+        }
         let (name, r) = match item {
+            ast::Item::Const(c) => {
+                let n = g.consts.len();
+                let consts = &g.consts;
+                if const_names.claim("constant", &c.name, n, |k| consts[k].name.span, diags) {
+                    g.consts.push(c);
+                }
+                continue;
+            }
             ast::Item::Enum(e) => (&e.name, ItemRef::Enum(EnumId(g.enums.len() as u32))),
             ast::Item::Buffer(b) => (
                 &b.name,
@@ -204,9 +249,27 @@ fn collect_items<'a>(files: &'a [ast::File], diags: &mut Diagnostics) -> Globals
             ast::Item::Enum(e) => g.enums.push(e),
             ast::Item::Buffer(b) => g.buffers.push(b),
             ast::Item::Controller(c) => g.controllers.push(c),
+            ast::Item::Const(_) => {}
+        }
+    }
+    // Constants and items share no names (a controller's name is a value
+    // in `X.status`, and one name for two things only confuses readers).
+    for c in &g.consts {
+        if let Some((_, first)) = g.names.get(c.name.text.as_str()) {
+            diags.push(duplicate("name", &c.name.text, c.name.span, *first));
         }
     }
     g
+}
+
+/// The name an item declares, for the reserved-name check.
+fn item_name(item: &ast::Item) -> Option<&ast::Name> {
+    Some(match item {
+        ast::Item::Enum(e) => &e.name,
+        ast::Item::Buffer(b) => &b.name,
+        ast::Item::Controller(c) => &c.name,
+        ast::Item::Const(c) => &c.name,
+    })
 }
 
 fn lower_enums(g: &Globals, ir: &mut Ir, diags: &mut Diagnostics) {
@@ -214,6 +277,9 @@ fn lower_enums(g: &Globals, ir: &mut Ir, diags: &mut Diagnostics) {
         let mut variants: Vec<Variant> = Vec::new();
         let mut names = ByName::default();
         for (docs, v) in &e.variants {
+            if let Some(d) = consts::reserved(v) {
+                diags.push(d);
+            }
             if !names.claim("variant", v, variants.len(), |k| variants[k].span, diags) {
                 continue;
             }
@@ -250,9 +316,29 @@ pub(crate) fn resolve_type(
     t: &ast::TypeExpr,
     diags: &mut Diagnostics,
 ) -> Option<Type> {
+    resolve_type_in(g, g.scope.get(), t, diags)
+}
+
+/// [`resolve_type`] with array lengths folded in the constants of
+/// controller `scope` (or the file's, for `None`).
+pub(crate) fn resolve_type_in(
+    g: &Globals,
+    scope: Option<usize>,
+    t: &ast::TypeExpr,
+    diags: &mut Diagnostics,
+) -> Option<Type> {
     match t {
-        ast::TypeExpr::Array { elem, len, span } => {
-            let elem = resolve_type(g, elem, diags)?;
+        ast::TypeExpr::Array {
+            elem,
+            len,
+            span,
+            len_expr,
+        } => {
+            let elem = resolve_type_in(g, scope, elem, diags)?;
+            if let Some(e) = len_expr {
+                let n = consts::array_len(g, scope, e, diags)?;
+                return Some(Type::Array(Box::new(elem), n as u32));
+            }
             if *len == 0 || *len > 65_536 {
                 diags.push(
                     Diagnostic::error(

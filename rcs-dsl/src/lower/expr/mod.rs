@@ -6,6 +6,7 @@
 //! declarations and plans that use the checker are in `lower::declarations`
 //! and `lower::plans`.
 
+mod builtins;
 mod names;
 mod operators;
 
@@ -284,7 +285,11 @@ impl Cx<'_, '_> {
                 }
             }
             ast::ExprKind::Path(qual, name) => self.path(qual.as_ref(), name, hint, span),
-            ast::ExprKind::Call(name, args) => self.call(name, args, span),
+            ast::ExprKind::Call(name, args) => match crate::builtin::Builtin::from_name(&name.text)
+            {
+                Some(b) => self.builtin(b, args, hint, span),
+                None => self.call(name, args, span),
+            },
             ast::ExprKind::Field(base, field) => self.field(base, field, span),
             ast::ExprKind::Index(base, idx) => {
                 let (b, bt) = self.infer(base, None);

@@ -134,6 +134,9 @@ impl Cx<'_, '_> {
             }
             None => {}
         }
+        if let Some(c) = self.g.consts_table.get(Some(self.ctrl.index()), &name.text) {
+            return self.constant(c, span);
+        }
         // A bare variant or status, resolved by the expected type first.
         match hint {
             Some(Type::Enum(eid)) => {
@@ -178,18 +181,13 @@ impl Cx<'_, '_> {
             }
             _ => {}
         }
-        let owners: Vec<(usize, usize)> = self
-            .ir
-            .enums
-            .iter()
-            .enumerate()
-            .filter_map(|(ei, en)| {
-                en.variants
-                    .iter()
-                    .position(|v| v.name == name.text)
-                    .map(|vi| (ei, vi))
-            })
-            .collect();
+        let owners = crate::lower::consts::variant_owners(
+            self.ir
+                .enums
+                .iter()
+                .map(|en| en.variants.iter().map(|v| v.name.as_str())),
+            &name.text,
+        );
         match owners.as_slice() {
             [(ei, vi)] => {
                 let eid = EnumId(*ei as u32);
@@ -279,7 +277,14 @@ impl Cx<'_, '_> {
                         name.span,
                         "not a hook",
                     )
-                    .with_help(format!("declare it: `hook {}(…) -> T`", name.text)),
+                    .with_help(match crate::builtin::closest(&name.text) {
+                        Some(b) => format!(
+                            "did you mean the built-in function `{}`? Else declare a hook: `hook {}(…) -> T`",
+                            b.name(),
+                            name.text
+                        ),
+                        None => format!("declare it: `hook {}(…) -> T`", name.text),
+                    }),
                 );
                 for a in args {
                     self.infer_untyped(a);

@@ -40,14 +40,19 @@ impl Cx<'_, '_> {
         if op == UnOp::Neg {
             match x.kind {
                 ExprKind::Int(v) => {
+                    // A typed constant (`-C`) wraps like any value of its type.
+                    let v = match &t {
+                        Ty::Known(Type::Int(it)) => crate::arith::wrap(-v, *it),
+                        _ => -v,
+                    };
                     return (
                         Expr {
-                            kind: ExprKind::Int(-v),
+                            kind: ExprKind::Int(v),
                             ty: x.ty,
                             span,
                         },
                         t,
-                    )
+                    );
                 }
                 ExprKind::Float(v) => {
                     return (

@@ -11,6 +11,7 @@ impl Builder {
         match def.as_rule() {
             Rule::enum_def => self.no_attributes(&outer, "an enum"),
             Rule::buffer_def => self.no_attributes(&outer, "a buffer"),
+            Rule::const_def => self.no_attributes(&outer, "a constant"),
             _ => {}
         }
         let mut inner = def.clone().into_inner();
@@ -76,7 +77,24 @@ impl Builder {
                     span,
                 })
             }
+            Rule::const_def => Item::Const(self.const_def(def)?),
             _ => return None,
+        })
+    }
+
+    /// `const NAME: TYPE = EXPR` (constants).
+    pub(in crate::parser) fn const_def(&mut self, p: Pair<Rule>) -> Option<ConstDef> {
+        let span = self.span(&p);
+        let mut inner = p.into_inner();
+        inner.next(); // the keyword
+        let name = self.name(inner.next()?);
+        let ty = self.type_expr(inner.next()?);
+        let value = self.expr(inner.next()?);
+        Some(ConstDef {
+            name,
+            ty,
+            value,
+            span,
         })
     }
 
@@ -106,11 +124,17 @@ impl Builder {
                 let span = self.span(&c);
                 let mut inner = c.into_inner();
                 let elem = self.type_expr(inner.next().expect("element type"));
-                let len = self.int(inner.next().expect("array length"));
+                let len = inner.next().expect("array length");
+                let (len, len_expr) = if len.as_rule() == Rule::int_lit {
+                    (self.int(len), None)
+                } else {
+                    (0, Some(Box::new(self.expr(len))))
+                };
                 TypeExpr::Array {
                     elem: Box::new(elem),
                     len,
                     span,
+                    len_expr,
                 }
             }
             _ => TypeExpr::Named(self.name(c)),
@@ -192,6 +216,7 @@ impl Builder {
                 let rows = inner.map(|r| self.row(r)).collect();
                 EntryKind::Plan(PlanDef { verb, header, rows })
             }
+            Rule::const_def => EntryKind::Const(self.const_def(decl)?),
             _ => return None,
         };
         Some(Entry { outer, kind, span })

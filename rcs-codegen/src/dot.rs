@@ -60,7 +60,7 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
         "digraph {} {{",
         quoted(&format!("{}.{verb}", ctrl.name))
     );
-    let title = format!("{} · {verb}", ctrl.name);
+    let title = format!("{} · {}", ctrl.name, ctrl.plan_title(plan));
     let _ = writeln!(
         out,
         "    graph [label={}, labelloc=t, rankdir=LR, fontname=\"Helvetica\", tooltip={}];",

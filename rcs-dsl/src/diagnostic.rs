@@ -53,12 +53,14 @@ pub enum Code {
     LooseFile,
     TooLarge,
     CaseCollision,
+    PlanVerbsDiffer,
+    ForwardMismatch,
     Lint(Lint),
 }
 
 impl Code {
     /// Every hard-error code, in catalogue order (lints follow in [`Lint::ALL`]).
-    pub const ERRORS: [Code; 23] = [
+    pub const ERRORS: [Code; 25] = [
         Code::Syntax,
         Code::DuplicateDefinition,
         Code::UnknownName,
@@ -82,6 +84,8 @@ impl Code {
         Code::LooseFile,
         Code::TooLarge,
         Code::CaseCollision,
+        Code::PlanVerbsDiffer,
+        Code::ForwardMismatch,
     ];
 
     pub fn name(self) -> &'static str {
@@ -109,6 +113,8 @@ impl Code {
             Code::LooseFile => "loose_file",
             Code::TooLarge => "too_large",
             Code::CaseCollision => "case_collision",
+            Code::PlanVerbsDiffer => "plan_verbs_differ",
+            Code::ForwardMismatch => "forward_mismatch",
             Code::Lint(l) => l.name(),
         }
     }
@@ -143,6 +149,8 @@ impl Code {
             Code::CaseCollision => {
                 "two names differ only in case where they become one output file name"
             }
+            Code::PlanVerbsDiffer => "the verbs of one plan do not have the same parameters",
+            Code::ForwardMismatch => "a forwarded command is not declared alike by the subordinate",
             Code::Lint(Lint::RuleOfTen) => "a plan has more rows than the rule of ten allows",
             Code::Lint(Lint::ShadowedRow) => "earlier rows always match before this row",
             Code::Lint(Lint::UnreachableState) => "no path from the entry reaches a state",

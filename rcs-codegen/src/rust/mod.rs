@@ -11,6 +11,7 @@ mod names;
 mod plan;
 mod system;
 mod types;
+mod verbs;
 
 use crate::GENERATED;
 use proc_macro2::TokenStream;

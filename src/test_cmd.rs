@@ -321,6 +321,10 @@ pub fn coverage(set: &PlanSet, ir: &Ir, fired: &Fired) -> (String, usize, usize)
         for (vi, k) in c.commands.iter().enumerate() {
             let Some(pid) = k.plan else { continue };
             let plan = &c.plans[pid.index()];
+            // A shared plan (`plan A | B`) is counted once, as its first verb.
+            if plan.verb.index() != vi {
+                continue;
+            }
             let missing: Vec<_> = plan
                 .rows
                 .iter()
@@ -335,7 +339,7 @@ pub fn coverage(set: &PlanSet, ir: &Ir, fired: &Fired) -> (String, usize, usize)
             all += n;
             text.push_str(&format!(
                 "  {:<24} {}/{} rows\n",
-                format!("{}.{}", c.name, k.name),
+                format!("{}.{}", c.name, c.plan_title(plan)),
                 n - missing.len(),
                 n
             ));

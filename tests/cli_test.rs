@@ -25,11 +25,11 @@ fn scenario_count(set: &str) -> usize {
 fn coverage_lines(out: &str) -> Vec<(String, usize, usize)> {
     out.lines()
         .filter_map(|l| {
-            let l = l.trim();
-            let (name, rest) = l.split_once(' ')?;
-            let (frac, _) = rest.trim().split_once(" rows")?;
+            // A shared plan's name has spaces: `TASK.HOME | UNHOME  3/3 rows`.
+            let (head, _) = l.trim().split_once(" rows")?;
+            let (name, frac) = head.rsplit_once(' ')?;
             let (a, b) = frac.split_once('/')?;
-            Some((name.to_string(), a.parse().ok()?, b.parse().ok()?))
+            Some((name.trim().to_string(), a.parse().ok()?, b.parse().ok()?))
         })
         .collect()
 }
@@ -285,4 +285,23 @@ fn a_run_with_no_scenario_is_an_error_and_an_untested_set_a_warning() {
     );
     assert!(text(&o.stdout).ends_with("1 passed, 0 failed\n"));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `plan A | B` and `X <- cmd` (tests/data/ok/0300): each verb runs its
+/// shared plan, the forwarded command is sent as received, and coverage
+/// counts each shared plan once, named by all its verbs.
+#[test]
+fn shared_plans_and_forwarding_pass_their_scenarios_with_every_row_covered() {
+    let set = "tests/data/ok/0300_verbs_pass_through";
+    let out = rcsc(&["test", set, "--coverage"]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{}", text(&out.stderr));
+    let n = scenario_count(set);
+    assert_eq!(stdout.lines().filter(|l| l.ends_with("... ok")).count(), n);
+    // TASK 3 plans, MOT 3: one coverage line per plan, not per verb.
+    assert_full_coverage(&stdout, 6);
+    assert!(
+        stdout.contains("TASK.HOME | UNHOME | JOG_STOP"),
+        "a shared plan is named by its verbs:\n{stdout}"
+    );
 }

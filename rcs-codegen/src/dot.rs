@@ -221,7 +221,13 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
     let source = &ir.files[plan.header.file.0 as usize];
     let mut out = String::new();
     header(&mut out, source);
-    graph_head(&mut out, &format!("{}.{verb}", ctrl.name), &plan.docs);
+    let title = format!("{} · {}", ctrl.name, ctrl.plan_title(plan));
+    graph_head(
+        &mut out,
+        &format!("{}.{verb}", ctrl.name),
+        &title,
+        &plan.docs,
+    );
 
     // Nodes in order of first appearance in the rows.
     let mut emitted: Vec<String> = Vec::new();
@@ -286,13 +292,12 @@ pub(crate) fn write_edge(out: &mut String, e: &Edge, all: &[Edge], extra: &str) 
 }
 
 /// `digraph NAME {` and the graph, node and edge defaults.
-pub(crate) fn graph_head(out: &mut String, name: &str, docs: &[String]) {
+pub(crate) fn graph_head(out: &mut String, name: &str, title: &str, docs: &[String]) {
     let _ = writeln!(out, "digraph {} {{", quoted(name));
-    let title = name.replacen('.', " · ", 1);
     let _ = writeln!(
         out,
         "    graph [label={}, labelloc=t, rankdir=LR, fontname=\"Helvetica\", tooltip={}];",
-        quoted(&title),
+        quoted(title),
         quoted(&docs.join("\n"))
     );
     out.push_str("    node [fontname=\"Helvetica\", shape=circle];\n");

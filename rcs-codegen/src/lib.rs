@@ -79,8 +79,13 @@ pub fn generate_with(ir: &Ir, options: &Options) -> Vec<OutputFile> {
         contents: rust::system_module(ir, options),
     }];
     for ctrl in &ir.controllers {
-        for cmd in &ctrl.commands {
+        for (ci, cmd) in ctrl.commands.iter().enumerate() {
             let Some(pid) = cmd.plan else { continue };
+            // A plan shared by verbs (`plan A | B`) is one graph, filed
+            // under its first verb.
+            if ctrl.plans[pid.index()].verb.index() != ci {
+                continue;
+            }
             files.push(OutputFile {
                 path: format!("graphs/{}/{}.dot", ctrl.name, cmd.name),
                 contents: dot::plan_graph(ir, ctrl, &ctrl.plans[pid.index()]),

@@ -53,9 +53,15 @@ pub fn controller_tables(ir: &Ir, ctrl: &Controller) -> String {
             subs.join(", ")
         }
     );
-    for cmd in &ctrl.commands {
+    for (ci, cmd) in ctrl.commands.iter().enumerate() {
         let Some(pid) = cmd.plan else { continue };
         let plan = &ctrl.plans[pid.index()];
+        // A plan shared by verbs (`plan A | B`) is one table, where its
+        // first verb stands, titled with all of them.
+        if plan.verb.index() != ci {
+            continue;
+        }
+        let title = ctrl.plan_title(plan);
         let p = Printer::new(ir, ctrl, Some(plan));
         let params: Vec<String> = cmd
             .params
@@ -63,9 +69,9 @@ pub fn controller_tables(ir: &Ir, ctrl: &Controller) -> String {
             .map(|x| format!("{}: {}", x.name, rcs_dsl::type_name(ir, &x.ty)))
             .collect();
         if params.is_empty() {
-            let _ = writeln!(out, "## {}\n", cmd.name);
+            let _ = writeln!(out, "## {title}\n");
         } else {
-            let _ = writeln!(out, "## {}({})\n", cmd.name, params.join(", "));
+            let _ = writeln!(out, "## {title}({})\n", params.join(", "));
         }
         let docs: Vec<&String> = cmd.docs.iter().chain(&plan.docs).collect();
         if !docs.is_empty() {

@@ -145,6 +145,8 @@ pub struct PlanDef {
     /// `plan VERB` — the header, where plan-wide diagnostics point.
     pub header: Span,
     pub rows: Vec<Row>,
+    /// The verbs after the first in `plan A | B | C` (empty for one verb).
+    pub more_verbs: Vec<Name>,
 }
 
 #[derive(Clone, Debug)]
@@ -204,6 +206,11 @@ pub enum Job {
         span: Span,
     },
     Call(Expr),
+    /// `X <- cmd`: forward the current command to subordinate `X`.
+    Forward {
+        sub: Name,
+        span: Span,
+    },
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]

@@ -56,12 +56,14 @@ pub enum Code {
     NotConstant,
     ConstCycle,
     ReservedName,
+    PlanVerbsDiffer,
+    ForwardMismatch,
     Lint(Lint),
 }
 
 impl Code {
     /// Every hard-error code, in catalogue order (lints follow in [`Lint::ALL`]).
-    pub const ERRORS: [Code; 26] = [
+    pub const ERRORS: [Code; 28] = [
         Code::Syntax,
         Code::DuplicateDefinition,
         Code::UnknownName,
@@ -88,6 +90,8 @@ impl Code {
         Code::NotConstant,
         Code::ConstCycle,
         Code::ReservedName,
+        Code::PlanVerbsDiffer,
+        Code::ForwardMismatch,
     ];
 
     pub fn name(self) -> &'static str {
@@ -118,6 +122,8 @@ impl Code {
             Code::NotConstant => "not_constant",
             Code::ConstCycle => "const_cycle",
             Code::ReservedName => "reserved_name",
+            Code::PlanVerbsDiffer => "plan_verbs_differ",
+            Code::ForwardMismatch => "forward_mismatch",
             Code::Lint(l) => l.name(),
         }
     }
@@ -155,6 +161,8 @@ impl Code {
             Code::NotConstant => "a `const` or an array length is not a constant expression",
             Code::ConstCycle => "constants are defined in terms of each other",
             Code::ReservedName => "a declaration takes the name of a built-in function",
+            Code::PlanVerbsDiffer => "the verbs of one plan do not have the same parameters",
+            Code::ForwardMismatch => "a forwarded command is not declared alike by the subordinate",
             Code::Lint(Lint::RuleOfTen) => "a plan has more rows than the rule of ten allows",
             Code::Lint(Lint::ShadowedRow) => "earlier rows always match before this row",
             Code::Lint(Lint::UnreachableState) => "no path from the entry reaches a state",

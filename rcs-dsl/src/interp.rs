@@ -20,6 +20,9 @@ use crate::arith::truthy;
 pub use crate::arith::{checked, float_to_int, round, wrap};
 pub use rcs_runtime::driver::Value;
 
+/// `X <- cmd`: the command a forward sends.
+mod verbs;
+
 /// The zero value of a type: numbers 0, `false`, the first variant.
 pub fn zero(ir: &Ir, t: &Type) -> Value {
     match t {
@@ -364,18 +367,16 @@ impl<'ir> Interpreter<'ir> {
                 sub, command, args, ..
             } => {
                 let args: Vec<Value> = args.iter().map(|a| self.eval(a, hooks)).collect();
-                let i = self.ctrl.subordinate_index(*sub).expect("a subordinate");
-                let serial = self.subs[i].link.next_command();
-                sent.push(Sent {
-                    sub: *sub,
-                    command: *command,
-                    args,
-                    serial,
-                });
+                self.send(*sub, *command, args, sent);
             }
             Job::Report { status, .. } => self.bk.report(Status(status.0 as u16)),
             Job::Call(e) => {
                 self.eval(e, hooks);
+            }
+            Job::Forward { sub, .. } => {
+                if let Some((command, args)) = self.forwarded(j) {
+                    self.send(*sub, command, args, sent);
+                }
             }
         }
     }

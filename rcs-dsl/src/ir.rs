@@ -327,6 +327,16 @@ pub struct Plan {
     /// `plan VERB`.
     pub header: Span,
     pub span: Span,
+    /// Every verb of the plan in header order (`plan A | B`); `verbs[0] ==
+    /// verb`. The verbs share their parameters (names, types, order), so
+    /// `CmdParam(verb, p)` reads parameter `p` of whichever verb is running.
+    /// Left out of `rcsc ir` for a plan of one verb (it is `[verb]`).
+    #[serde(skip_serializing_if = "one_verb")]
+    pub verbs: Vec<CommandId>,
+}
+
+fn one_verb(verbs: &[CommandId]) -> bool {
+    verbs.len() == 1
 }
 
 impl Plan {
@@ -428,6 +438,15 @@ pub enum Job {
     },
     /// A hook called for its effect; `call` is an `ExprKind::Call`.
     Call(Expr),
+    /// `X <- cmd`: send the current command, verb and arguments as
+    /// received, to `sub`. `commands` maps each verb of the plan to the
+    /// subordinate's command of the same name and parameters, in
+    /// [`Plan::verbs`] order.
+    Forward {
+        sub: CtrlId,
+        commands: Vec<(CommandId, CommandId)>,
+        span: Span,
+    },
 }
 
 /// Something a job may assign to: a var or a `writes` buffer, then fields
@@ -554,6 +573,15 @@ impl Controller {
         self.subordinates.iter().position(|s| *s == sub)
     }
 
+    /// A plan's name for people: its verbs as in its header, `GOTO | JOG`.
+    pub fn plan_title(&self, p: &Plan) -> String {
+        p.verbs
+            .iter()
+            .map(|v| self.commands[v.index()].name.as_str())
+            .collect::<Vec<_>>()
+            .join(" | ")
+    }
+
     /// The plan of a verb, by name.
     pub fn plan_of(&self, verb: &str) -> Option<&Plan> {
         let c = self.commands.iter().find(|c| c.name == verb)?;
@@ -593,8 +621,29 @@ impl Row {
                 Job::Assign { value, .. } => value.visit(f),
                 Job::Send { args, .. } => args.iter().for_each(|a| a.visit(f)),
                 Job::Call(e) => e.visit(f),
-                Job::Report { .. } => {}
+                Job::Report { .. } | Job::Forward { .. } => {}
             }
+        }
+    }
+}
+
+impl Job {
+    /// The subordinate a `Send` or `Forward` job commands, and the job's
+    /// span: both are a send with a new serial to every check.
+    pub fn sends_to(&self) -> Option<(CtrlId, Span)> {
+        match self {
+            Job::Send { sub, span, .. } | Job::Forward { sub, span, .. } => Some((*sub, *span)),
+            _ => None,
+        }
+    }
+
+    /// The subordinate's commands this job can send: one for a `Send`, one
+    /// per verb of the plan for a `Forward`.
+    pub fn commands_sent(&self) -> Vec<CommandId> {
+        match self {
+            Job::Send { command, .. } => vec![*command],
+            Job::Forward { commands, .. } => commands.iter().map(|(_, theirs)| *theirs).collect(),
+            _ => Vec::new(),
         }
     }
 }

@@ -184,6 +184,9 @@ impl<'a> Printer<'a> {
                 format!("report {}", self.ctrl.statuses[status.index()].name)
             }
             Job::Call(e) => self.expr(e),
+            Job::Forward { sub, .. } => {
+                format!("{} <- cmd", self.ir.controllers[sub.index()].name)
+            }
         }
     }
 

@@ -32,7 +32,8 @@ pub fn diff_dot(plan: &PlanDiff, source: &str) -> String {
         crate::GENERATED,
         plan.name()
     );
-    graph_head(&mut out, &plan.name(), &[]);
+    let name = plan.name();
+    graph_head(&mut out, &name, &name.replacen('.', " · ", 1), &[]);
     let moved: Vec<&str> = plan
         .moves
         .iter()

@@ -175,7 +175,7 @@ pub(crate) fn module(
         let ty = &pn.state_ty;
         let vs = &pn.states;
         let ids: Vec<u16> = (0..p.states.len() as u16).collect();
-        let doc = format!(" The states of plan `{}`.", c.commands[p.verb.index()].name);
+        let doc = format!(" The states of plan `{}`.", c.plan_title(p));
         let plan_docs = paragraph(&p.docs);
         let state_names: Vec<&str> = p.states.iter().map(|s| s.name.as_str()).collect();
         quote! {
@@ -326,7 +326,7 @@ pub(crate) fn module(
         let pid = k.plan?;
         let func = &n.plans[pid.index()].func;
         let v = &n.commands[i];
-        let used = used_params(&c.plans[pid.index()]);
+        let used = used_params(c, &c.plans[pid.index()]);
         let binds: Vec<TokenStream> = k
             .params
             .iter()

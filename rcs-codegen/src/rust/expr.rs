@@ -224,7 +224,7 @@ fn fold_cast(e: &Expr, to: &Type) -> Option<Code> {
 }
 
 impl Gen<'_> {
-    fn cn(&self) -> &super::names::CtrlNames {
+    pub(super) fn cn(&self) -> &super::names::CtrlNames {
         &self.names.ctrls[self.ci]
     }
 
@@ -545,18 +545,8 @@ impl Gen<'_> {
             Job::Send {
                 sub, command, args, ..
             } => {
-                let i = self.ctrl.subordinate_index(*sub).expect("a subordinate");
-                let field = prefixed("sub", &self.cn().subs[i]);
-                let target = &self.names.ctrls[sub.index()];
-                let module = &target.module;
-                let variant = &target.commands[command.index()];
-                if args.is_empty() {
-                    quote!(self.#field.send(super::#module::Command::#variant);)
-                } else {
-                    let params = &target.params[command.index()];
-                    let vals: Vec<TokenStream> = args.iter().map(|a| self.expr(a).ts).collect();
-                    quote!(self.#field.send(super::#module::Command::#variant { #(#params: #vals),* });)
-                }
+                let vals: Vec<TokenStream> = args.iter().map(|a| self.expr(a).ts).collect();
+                self.send(*sub, *command, &vals)
             }
             Job::Report { status, .. } => {
                 let c = &self.cn().status_consts[status.index()];
@@ -567,6 +557,28 @@ impl Gen<'_> {
                 let ts = &c.ts;
                 quote!(#ts;)
             }
+            Job::Forward { sub, commands, .. } => self.forward(*sub, commands),
+        }
+    }
+
+    /// `sub`'s `command`, with `vals` in its parameter order, sent under a
+    /// new serial.
+    pub(super) fn send(
+        &self,
+        sub: CtrlId,
+        command: CommandId,
+        vals: &[TokenStream],
+    ) -> TokenStream {
+        let i = self.ctrl.subordinate_index(sub).expect("a subordinate");
+        let field = prefixed("sub", &self.cn().subs[i]);
+        let target = &self.names.ctrls[sub.index()];
+        let module = &target.module;
+        let variant = &target.commands[command.index()];
+        if vals.is_empty() {
+            quote!(self.#field.send(super::#module::Command::#variant);)
+        } else {
+            let params = &target.params[command.index()];
+            quote!(self.#field.send(super::#module::Command::#variant { #(#params: #vals),* });)
         }
     }
 }

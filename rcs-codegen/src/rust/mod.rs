@@ -12,6 +12,7 @@ mod names;
 mod plan;
 mod system;
 mod types;
+mod verbs;
 
 use crate::GENERATED;
 use proc_macro2::TokenStream;

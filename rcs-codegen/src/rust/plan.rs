@@ -32,8 +32,17 @@ pub(super) fn uses_subs(p: &Plan) -> bool {
     used
 }
 
-/// The parameters of the plan's command that its rows read.
-pub(super) fn used_params(p: &Plan) -> Vec<ParamId> {
+/// The parameters of the plan's command that its rows read: all of them
+/// when a row forwards the command (`X <- cmd`).
+pub(super) fn used_params(c: &Controller, p: &Plan) -> Vec<ParamId> {
+    let forwards = p
+        .rows
+        .iter()
+        .any(|r| r.jobs.iter().any(|j| matches!(j, Job::Forward { .. })));
+    if forwards {
+        let n = c.commands[p.verb.index()].params.len();
+        return (0..n as u32).map(ParamId).collect();
+    }
     let mut used = Vec::new();
     for r in &p.rows {
         r.visit_exprs(&mut |e| {
@@ -63,7 +72,7 @@ pub(super) fn plan_fn(
     let pn = &n.plans[pi];
     let func = &pn.func;
     let cmd = &c.commands[p.verb.index()];
-    let used = used_params(p);
+    let used = used_params(c, p);
     let args: Vec<TokenStream> = cmd
         .params
         .iter()
@@ -238,7 +247,11 @@ pub(super) fn plan_fn(
         }
     };
     let rows_word = if p.rows.len() == 1 { "row" } else { "rows" };
-    let doc = format!(" Plan `{}` ({} {rows_word}).", cmd.name, p.rows.len());
+    let doc = format!(
+        " Plan `{}` ({} {rows_word}).",
+        c.plan_title(p),
+        p.rows.len()
+    );
     let plan_docs = paragraph(&p.docs);
     quote! {
         #[doc = #doc] #plan_docs

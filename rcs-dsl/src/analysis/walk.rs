@@ -17,7 +17,7 @@
 
 use super::terms::Leaf;
 use super::{covers, Answer, LeafId, PlanAnalysis, Witness};
-use crate::ir::{Controller, CtrlId, Job, Plan, Row, StateId, StatusId, Target};
+use crate::ir::{Controller, CtrlId, Plan, Row, StateId, StatusId, Target};
 use rcs_runtime::driver::Value;
 
 /// How many cycles a walk takes at most, and how many places it keeps per
@@ -380,10 +380,9 @@ pub(super) fn target_state(row: &Row, from: StateId) -> Option<StateId> {
 
 /// The subordinates a row sends to, in order.
 pub(super) fn sends(row: &Row) -> impl Iterator<Item = CtrlId> + '_ {
-    row.jobs.iter().filter_map(|j| match j {
-        Job::Send { sub, .. } => Some(*sub),
-        _ => None,
-    })
+    row.jobs
+        .iter()
+        .filter_map(|j| j.sends_to().map(|(sub, _)| sub))
 }
 
 pub(super) fn is_counter(leaf: &Leaf) -> bool {

@@ -187,7 +187,7 @@ pub(crate) fn check_unreachable_states(c: &Controller, p: &Plan, a: &Analysis, s
                 format!(
                     "state `{}` of plan `{}` is never reached",
                     s.name,
-                    c.commands[p.verb.index()].name
+                    c.plan_title(p)
                 ),
                 span,
                 "no path from the entry leads here",
@@ -218,7 +218,7 @@ pub(crate) fn check_dead_ends(c: &Controller, p: &Plan, a: &Analysis, sink: &mut
             Some(p),
             Diagnostic::lint(
                 Lint::DeadEndState,
-                format!("state `{}` of plan `{}` has no way out", s.name, c.commands[p.verb.index()].name),
+                format!("state `{}` of plan `{}` has no way out", s.name, c.plan_title(p)),
                 span,
                 if a.leaves[i] {
                     "rows lead back here, and only a new command leaves"
@@ -244,7 +244,7 @@ pub(crate) fn check_no_done(ir: &Ir, c: &Controller, p: &Plan, a: &Analysis, sin
             Lint::NoDone,
             format!(
                 "plan `{}` of `{}` never reaches `Done` or `Error`",
-                c.commands[p.verb.index()].name,
+                c.plan_title(p),
                 c.name
             ),
             p.header,

@@ -62,10 +62,10 @@ pub(crate) fn check_unhandled_error(ir: &Ir, plans: &Plans, sink: &mut Sink) {
                     let run = conditions.stall_run(paths, state, &w, STALL_CYCLES);
                     let sub = &ir.controller(x).name;
                     let state_name = &p.states[s].name;
-                    let verb = &c.commands[p.verb.index()].name;
+                    let verb = &c.plan_title(p);
                     let (xp, xr) = fails;
                     let x_ctrl = ir.controller(x);
-                    let x_verb = &x_ctrl.commands[x_ctrl.plans[xp].verb.index()].name;
+                    let x_verb = &x_ctrl.plan_title(&x_ctrl.plans[xp]);
                     let x_row = &x_ctrl.plans[xp].rows[xr];
                     let d = Diagnostic::lint(
                         Lint::UnhandledError,
@@ -103,9 +103,11 @@ fn verbs_sent(rows: &[Row], x: CtrlId) -> Vec<CommandId> {
     let mut verbs = Vec::new();
     for r in rows {
         for j in &r.jobs {
-            if let Job::Send { sub, command, .. } = j {
-                if *sub == x && !verbs.contains(command) {
-                    verbs.push(*command);
+            if j.sends_to().is_some_and(|(sub, _)| sub == x) {
+                for command in j.commands_sent() {
+                    if !verbs.contains(&command) {
+                        verbs.push(command);
+                    }
                 }
             }
         }

@@ -24,7 +24,7 @@ pub(crate) fn check_incomplete_states(
     graph: &super::graph::Analysis,
     sink: &mut Sink,
 ) {
-    let verb = &c.commands[p.verb.index()].name;
+    let verb = &c.plan_title(p);
     for hang in conditions.hangs() {
         // One state, one finding: a dead end is `dead_end_state`'s.
         if graph.is_dead_end(p, hang.state.index()) {

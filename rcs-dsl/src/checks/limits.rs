@@ -51,7 +51,7 @@ pub(crate) fn check_limits(ir: &Ir, sink: &mut Sink) -> bool {
             }
         }
         for p in &c.plans {
-            let verb = &c.commands[p.verb.index()].name;
+            let verb = &c.plan_title(p);
             for (what, count) in [("states", p.states.len()), ("rows", p.rows.len())] {
                 if count > MAX_COUNT {
                     let name = format!("plan `{verb}` of `{}`: {what}", c.name);

@@ -24,7 +24,7 @@ fn state_name(p: &Plan, s: StateId) -> &str {
 }
 
 pub(crate) fn check_livelocks(c: &Controller, p: &Plan, an: &PlanAnalysis, sink: &mut Sink) {
-    let verb = &c.commands[p.verb.index()].name;
+    let verb = &c.plan_title(p);
     for found in livelocks(c, p, an) {
         let Some(&(first, first_state)) = found.cycle.first() else {
             continue;
@@ -120,7 +120,7 @@ pub(crate) fn check_command_storms(
             format!(
                 "{} of plan `{}` sends `{sub}` a command on every cycle while `{sub}` executes",
                 row_name(found.row),
-                c.commands[p.verb.index()].name
+                c.plan_title(p)
             ),
             row.span,
             format!("sends to `{sub}` and can fire again on the next cycle"),

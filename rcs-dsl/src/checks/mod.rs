@@ -49,7 +49,7 @@ impl Sink<'_> {
             |lints: &[(Lint, crate::lint::Level)]| lints.iter().any(|(l, _)| *l == lint);
         let source = match (ctrl, plan) {
             (Some(c), Some(p)) if by_attribute(&p.lints) => {
-                Source::Attribute(format!("plan `{}`", c.commands[p.verb.index()].name))
+                Source::Attribute(format!("plan `{}`", c.plan_title(p)))
             }
             (Some(c), _) if by_attribute(&c.lints) => {
                 Source::Attribute(format!("controller `{}`", c.name))

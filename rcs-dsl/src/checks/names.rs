@@ -64,8 +64,13 @@ pub(crate) fn check_case_collisions(ir: &Ir, sink: &mut Sink) {
         let verbs = c
             .commands
             .iter()
-            .filter(|cmd| cmd.plan.is_some())
-            .map(|cmd| (cmd.name.as_str(), cmd.span));
+            .enumerate()
+            // A plan's graph is filed under its first verb (`plan A | B`).
+            .filter(|(i, cmd)| {
+                cmd.plan
+                    .is_some_and(|p| c.plans[p.index()].verb.index() == *i)
+            })
+            .map(|(_, cmd)| (cmd.name.as_str(), cmd.span));
         for ((a, a_span), (b, b_span)) in case_pairs(verbs) {
             let ctrl = &c.name;
             sink.error(

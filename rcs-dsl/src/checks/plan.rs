@@ -9,8 +9,8 @@ use crate::diagnostic::{Code, Diagnostic};
 use crate::ir::{Condition, Controller, Expr, ExprKind, From, Ir, Job, Plan, Row, StateId};
 use crate::lint::Lint;
 
-fn verb<'a>(c: &'a Controller, p: &Plan) -> &'a str {
-    &c.commands[p.verb.index()].name
+fn verb(c: &Controller, p: &Plan) -> String {
+    c.plan_title(p)
 }
 
 pub(crate) fn check_missing_plans(ir: &Ir, sink: &mut Sink) {
@@ -294,14 +294,8 @@ pub(crate) fn check_shadowed_rows(
 
 pub(crate) fn check_double_commands(ir: &Ir, p: &Plan, sink: &mut Sink) {
     for r in &p.rows {
-        let sends: Vec<(crate::ir::CtrlId, crate::source::Span)> = r
-            .jobs
-            .iter()
-            .filter_map(|j| match j {
-                Job::Send { sub, span, .. } => Some((*sub, *span)),
-                _ => None,
-            })
-            .collect();
+        let sends: Vec<(crate::ir::CtrlId, crate::source::Span)> =
+            r.jobs.iter().filter_map(Job::sends_to).collect();
         for (i, (sub, span)) in sends.iter().enumerate() {
             if let Some((_, first)) = sends[..i].iter().find(|(s, _)| s == sub) {
                 let name = &ir.controllers[sub.index()].name;

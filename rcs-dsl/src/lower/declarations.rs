@@ -233,6 +233,7 @@ pub(super) fn lower_controller_body(
             const_ctx: true,
             unresolved_hooks,
             diags,
+            plan_verbs: Vec::new(),
         };
         for e in &c.entries {
             match &e.kind {
@@ -258,29 +259,20 @@ pub(super) fn lower_controller_body(
                     inits.push((vi, e));
                 }
                 ast::EntryKind::Plan(p) => {
-                    let Some(cmd) = names.controllers[id.index()].commands.get(&p.verb.text) else {
-                        cx.diags.push(
-                            Diagnostic::error(
-                                Code::UnknownCommand,
-                                format!("`{}` has no command `{}`", ctrl.name, p.verb.text),
-                                p.verb.span,
-                                "no such command",
-                            )
-                            .with_help(format!("declare it: `command {}`", p.verb.text)),
-                        );
+                    let Some(verbs) = cx.plan_verbs(p, &plan_of, &plans) else {
                         continue;
                     };
-                    if let Some(prev) = plan_of[cmd] {
-                        let first: &Plan = &plans[prev.index()];
-                        cx.diags
-                            .push(duplicate("plan", &p.verb.text, p.verb.span, first.header));
-                        continue;
-                    }
+                    let cmd = verbs[0];
                     cx.const_ctx = false;
-                    cx.plan_cmd = Some(CommandId(cmd as u32));
-                    let plan = cx.plan(p, CommandId(cmd as u32), &e.outer);
-                    plan_of[cmd] = Some(PlanId(plans.len() as u32));
+                    cx.plan_cmd = Some(cmd);
+                    cx.plan_verbs = verbs.clone();
+                    let mut plan = cx.plan(p, cmd, &e.outer);
+                    for v in &verbs {
+                        plan_of[v.index()] = Some(PlanId(plans.len() as u32));
+                    }
+                    plan.verbs = verbs;
                     plans.push(plan);
+                    cx.plan_verbs.clear();
                 }
                 _ => {}
             }

@@ -12,6 +12,7 @@ mod declarations;
 mod expr;
 mod index;
 mod plans;
+mod verbs;
 pub use expr::type_name;
 
 use crate::ast;

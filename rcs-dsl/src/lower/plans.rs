@@ -34,6 +34,7 @@ impl Cx<'_, '_> {
             .map(|r| p.header.to(r.span))
             .unwrap_or(p.header);
         Plan {
+            verbs: vec![cmd],
             verb: cmd,
             docs: outer.docs.clone(),
             states,
@@ -218,28 +219,19 @@ impl Cx<'_, '_> {
                 args,
                 span,
             } => self.send(sub, verb, args, *span),
+            ast::Job::Forward { sub, span } => self.forward(sub, *span),
         }
     }
 
-    pub(in crate::lower) fn send(
-        &mut self,
-        sub: &ast::Name,
-        verb: &ast::Name,
-        args: &[(ast::Name, ast::Expr)],
-        span: Span,
-    ) -> Option<Job> {
-        let infer_all = |cx: &mut Self| {
-            for (_, a) in args {
-                cx.infer_untyped(a);
-            }
-        };
-        let sid = match self
+    /// The subordinate `sub` names, or `None` with `unknown_subordinate`.
+    pub(in crate::lower) fn subordinate_named(&mut self, sub: &ast::Name) -> Option<CtrlId> {
+        match self
             .c
             .subordinates
             .iter()
             .find(|s| self.ir.controllers[s.index()].name == sub.text)
         {
-            Some(s) => *s,
+            Some(s) => Some(*s),
             None => {
                 let help = if matches!(
                     self.g.names.get(sub.text.as_str()),
@@ -261,9 +253,26 @@ impl Cx<'_, '_> {
                     )
                     .with_help(help),
                 );
-                infer_all(self);
-                return None;
+                None
             }
+        }
+    }
+
+    pub(in crate::lower) fn send(
+        &mut self,
+        sub: &ast::Name,
+        verb: &ast::Name,
+        args: &[(ast::Name, ast::Expr)],
+        span: Span,
+    ) -> Option<Job> {
+        let infer_all = |cx: &mut Self| {
+            for (_, a) in args {
+                cx.infer_untyped(a);
+            }
+        };
+        let Some(sid) = self.subordinate_named(sub) else {
+            infer_all(self);
+            return None;
         };
         let target = &self.ir.controllers[sid.index()];
         let Some(ci) = self.ix.controllers[sid.index()].commands.get(&verb.text) else {

@@ -115,7 +115,8 @@ pub struct Outcome {
     /// Rows fired, by name (`E3`; `-` for none), run-length encoded: each
     /// entry is a name and how many consecutive cycles fired it.
     pub fired: Vec<(String, u64)>,
-    /// Rows fired as (verb, row), for coverage.
+    /// Rows fired as (verb, row), for coverage; a plan's rows under its
+    /// first verb ([`Plan::verb`](crate::ir::Plan::verb)).
     pub rows: BTreeSet<(CommandId, RowId)>,
 }
 

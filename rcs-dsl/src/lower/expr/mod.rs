@@ -51,6 +51,8 @@ pub(in crate::lower) struct Cx<'a, 'g> {
     /// Hooks whose return type did not resolve: their calls fit everywhere.
     pub(in crate::lower) unresolved_hooks: Vec<String>,
     pub(in crate::lower) diags: &'a mut Diagnostics,
+    /// Inside a plan: all its verbs (`plan A | B`), for `X <- cmd`.
+    pub(in crate::lower) plan_verbs: Vec<CommandId>,
 }
 
 pub(in crate::lower) fn err_expr(span: Span) -> Expr {

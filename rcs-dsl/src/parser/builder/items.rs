@@ -211,10 +211,25 @@ impl Builder {
             Rule::plan_def => {
                 let kw = decl.clone().into_inner().next()?;
                 let verb_pair = inner.next()?;
-                let header = self.span(&kw).to(self.span(&verb_pair));
+                let mut header = self.span(&kw).to(self.span(&verb_pair));
                 let verb = self.name(verb_pair);
-                let rows = inner.map(|r| self.row(r)).collect();
-                EntryKind::Plan(PlanDef { verb, header, rows })
+                // `plan A | B | C`: the header runs to the last verb.
+                let mut more_verbs = Vec::new();
+                let mut rows = Vec::new();
+                for c in inner {
+                    if c.as_rule() == Rule::ident {
+                        header = header.to(self.span(&c));
+                        more_verbs.push(self.name(c));
+                    } else {
+                        rows.push(self.row(c));
+                    }
+                }
+                EntryKind::Plan(PlanDef {
+                    verb,
+                    header,
+                    rows,
+                    more_verbs,
+                })
             }
             Rule::const_def => EntryKind::Const(self.const_def(decl)?),
             _ => return None,

@@ -120,6 +120,7 @@ impl Builder {
                 Job::Report(n, span)
             }
             _ => {
+                let c_text = c.as_str();
                 let mut inner = c.into_inner();
                 let first = inner.next().expect("place");
                 match inner.next() {
@@ -141,7 +142,19 @@ impl Builder {
                                 }
                             }
                         };
-                        let verb = self.name(inner.next().expect("verb"));
+                        let verb_pair = inner.next().expect("verb");
+                        if verb_pair.as_str() == "cmd" {
+                            // `X <- cmd`: forward the current command as it is.
+                            if inner.next().is_some() || c_text.trim_end().ends_with(')') {
+                                self.error(
+                                    span,
+                                    "`X <- cmd` forwards the current command as it is and takes no arguments",
+                                    "arguments to a forwarded command",
+                                );
+                            }
+                            return Job::Forward { sub, span };
+                        }
+                        let verb = self.name(verb_pair);
                         let args = inner
                             .map(|a| {
                                 let mut ai = a.into_inner();

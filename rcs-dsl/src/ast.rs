@@ -114,6 +114,41 @@ pub enum EntryKind {
         ret: Option<TypeExpr>,
     },
     Plan(PlanDef),
+    /// `status NAME: TYPE = INIT`: a field of the controller's status buffer.
+    StatusField {
+        name: Name,
+        ty: TypeExpr,
+        init: Option<Expr>,
+    },
+    /// `pre { jobs }` or `post { jobs }`: jobs run every cycle.
+    EveryCycle(EveryCycleDef),
+}
+
+/// Which every-cycle block: before the rows (`pre`) or after them (`post`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Phase {
+    Pre,
+    Post,
+}
+
+impl Phase {
+    pub fn keyword(self) -> &'static str {
+        match self {
+            Phase::Pre => "pre",
+            Phase::Post => "post",
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct EveryCycleDef {
+    pub phase: Phase,
+    /// The keyword, where diagnostics about the block point.
+    pub keyword: Span,
+    pub jobs: Vec<Job>,
+    /// A `-> target` written after the block (always an error).
+    pub target: Option<Target>,
 }
 
 #[derive(Clone, Debug)]
@@ -189,6 +224,8 @@ pub enum Job {
         span: Span,
     },
     Call(Expr),
+    /// `report ERROR(CODE)`: the status name and the error code.
+    ReportCode(Name, Name, Span),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]

@@ -54,11 +54,13 @@ pub enum Code {
     TooLarge,
     CaseCollision,
     Lint(Lint),
+    EveryCycleDecision,
+    EveryCycleTwice,
 }
 
 impl Code {
     /// Every hard-error code, in catalogue order (lints follow in [`Lint::ALL`]).
-    pub const ERRORS: [Code; 23] = [
+    pub const ERRORS: [Code; 25] = [
         Code::Syntax,
         Code::DuplicateDefinition,
         Code::UnknownName,
@@ -82,6 +84,8 @@ impl Code {
         Code::LooseFile,
         Code::TooLarge,
         Code::CaseCollision,
+        Code::EveryCycleDecision,
+        Code::EveryCycleTwice,
     ];
 
     pub fn name(self) -> &'static str {
@@ -110,6 +114,8 @@ impl Code {
             Code::TooLarge => "too_large",
             Code::CaseCollision => "case_collision",
             Code::Lint(l) => l.name(),
+            Code::EveryCycleDecision => "every_cycle_decision",
+            Code::EveryCycleTwice => "every_cycle_twice",
         }
     }
 
@@ -167,6 +173,10 @@ impl Code {
             Code::Lint(Lint::StatusNeverReported) => {
                 "a supervisor waits for a status the subordinate never reports"
             }
+            Code::EveryCycleDecision => {
+                "a `pre` or `post` block sends, reports or changes state: decisions belong in the rows"
+            }
+            Code::EveryCycleTwice => "a controller has two `pre` or two `post` blocks",
         }
     }
 

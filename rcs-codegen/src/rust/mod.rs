@@ -6,6 +6,7 @@
 
 mod controller;
 mod driver;
+mod every_cycle;
 mod expr;
 mod names;
 mod plan;

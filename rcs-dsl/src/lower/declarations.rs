@@ -121,6 +121,24 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                         ty: ty.unwrap_or(Type::Unit),
                         init: None,
                         span: name.span,
+                        status_field: false,
+                    });
+                }
+                ast::EntryKind::StatusField { name, ty, .. } => {
+                    // A reserved name is reported, and the field still
+                    // declared so that its uses do not cascade.
+                    super::every_cycle::status_field_name_free(name, diags);
+                    if !claim(name, "name", diags) {
+                        continue;
+                    }
+                    let ty = resolve_type(g, ty, diags);
+                    vars.push(Var {
+                        name: name.text.to_string(),
+                        docs: docs.clone(),
+                        ty: ty.unwrap_or(Type::Unit),
+                        init: None,
+                        span: name.span,
+                        status_field: true,
                     });
                 }
                 ast::EntryKind::Hook { name, params, ret } => {
@@ -143,6 +161,7 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                 _ => {}
             }
         }
+        super::every_cycle::check_status_value_clash(&vars, &statuses, diags);
         let ctrl = &mut ir.controllers[i];
         ctrl.commands = commands;
         ctrl.statuses = statuses;
@@ -181,6 +200,7 @@ pub(super) fn lower_controller_body(
 ) {
     let mut inits = Vec::new();
     let mut plans: Vec<Plan> = Vec::new();
+    let (mut pre, mut post): (Option<EveryCycle>, Option<EveryCycle>) = (None, None);
     let mut plan_of: Vec<Option<PlanId>> = vec![None; ir.controllers[id.index()].commands.len()];
     {
         let ctrl = &ir.controllers[id.index()];
@@ -211,6 +231,11 @@ pub(super) fn lower_controller_body(
         for e in &c.entries {
             match &e.kind {
                 ast::EntryKind::Var {
+                    name,
+                    init: Some(init),
+                    ..
+                }
+                | ast::EntryKind::StatusField {
                     name,
                     init: Some(init),
                     ..
@@ -256,6 +281,15 @@ pub(super) fn lower_controller_body(
                     plan_of[cmd] = Some(PlanId(plans.len() as u32));
                     plans.push(plan);
                 }
+                ast::EntryKind::EveryCycle(def) => {
+                    cx.const_ctx = false;
+                    cx.plan_cmd = None;
+                    let slot = match def.phase {
+                        ast::Phase::Pre => &mut pre,
+                        ast::Phase::Post => &mut post,
+                    };
+                    cx.every_cycle(def, slot);
+                }
                 _ => {}
             }
         }
@@ -268,4 +302,6 @@ pub(super) fn lower_controller_body(
         cmd.plan = p;
     }
     ctrl.plans = plans;
+    ctrl.pre = pre;
+    ctrl.post = post;
 }

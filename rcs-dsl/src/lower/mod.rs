@@ -8,6 +8,7 @@
 //! expression it stood in gets an error type that fits everywhere.
 
 mod declarations;
+mod every_cycle;
 mod expr;
 mod index;
 mod plans;
@@ -417,6 +418,8 @@ fn lower_controller_headers<'a>(
             subordinates_lists: Vec::new(),
             buffer_spans: Vec::new(),
             buffer_docs: Vec::new(),
+            pre: None,
+            post: None,
         });
     }
     // Where each controller was named as a subordinate, for multiple_supervisors.

@@ -17,6 +17,7 @@
 
 pub mod config;
 pub mod dot;
+mod every_cycle;
 pub mod ident;
 pub mod rust;
 pub mod rustfmt;

@@ -21,7 +21,7 @@ pub(crate) enum Echo {
 }
 
 /// A subordinate writes its status buffer.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub(crate) struct Answer {
     pub(crate) echo: Echo,
     pub(crate) status: u16,

@@ -468,10 +468,7 @@ impl Cx<'_, '_> {
                 self.diags.push(
                     Diagnostic::error(
                         Code::UnknownName,
-                        format!(
-                            "subordinate `{}` has no property or status field `{other}`",
-                            x.text
-                        ),
+                        format!("subordinate `{}` has no property `{other}`", x.text),
                         field.span,
                         "unknown property",
                     )

@@ -9,6 +9,7 @@
 //! `post` and without subordinates that have status fields, so such
 //! controllers generate exactly what they did before these constructs.
 
+use super::controller::derivable_default;
 use super::expr::{rust_type, zero, Gen};
 use super::names::Names;
 use super::Comments;
@@ -92,14 +93,23 @@ pub(crate) fn parts(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments) 
             " `{}`'s status fields, published every cycle in Global Memory buffer `{}.status_fields` (zero before its first cycle).",
             c.name, c.name
         );
-        p.items.extend(quote! {
-            #[doc = #doc]
-            #[derive(Clone, Copy, Debug, PartialEq)]
-            pub struct StatusFields { #(#docs pub #fields: #tys),* }
-            impl Default for StatusFields {
-                fn default() -> Self { Self { #(#fields: #zeros),* } }
-            }
-        });
+        // Zero is every type's `Default` where std can derive it (arrays up to 32).
+        if own.iter().all(|(_, v)| derivable_default(&v.ty)) {
+            p.items.extend(quote! {
+                #[doc = #doc]
+                #[derive(Clone, Copy, Debug, Default, PartialEq)]
+                pub struct StatusFields { #(#docs pub #fields: #tys),* }
+            });
+        } else {
+            p.items.extend(quote! {
+                #[doc = #doc]
+                #[derive(Clone, Copy, Debug, PartialEq)]
+                pub struct StatusFields { #(#docs pub #fields: #tys),* }
+                impl Default for StatusFields {
+                    fn default() -> Self { Self { #(#fields: #zeros),* } }
+                }
+            });
+        }
         p.handles
             .extend(quote!(status_fields_out: rt::Writer<StatusFields>,));
         p.declares
@@ -192,9 +202,8 @@ pub(crate) fn driver_parts(
     let sub_names: Vec<&str> = subs.iter().map(|(_, _, s)| *s).collect();
     let arms = c.subordinates.iter().filter_map(|s| {
         let sc = ir.controller(*s);
-        if sc.status_fields().next().is_none() {
-            return None;
-        }
+        // Only subordinates that publish status fields get an arm.
+        sc.status_fields().next()?;
         let i = c.subordinate_index(*s).expect("a subordinate");
         let handle = prefixed("fields", &names.ctrls[ci].subs[i]);
         let sub_name = sc.name.as_str();

@@ -228,6 +228,14 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
         &title,
         &plan.docs,
     );
+    // Status fields and `pre`/`post` jobs: what runs every cycle, beside the plan.
+    if let Some(note) = crate::every_cycle::note(ir, ctrl) {
+        let _ = writeln!(
+            out,
+            "    \"every cycle\" [shape=note, fontsize=10, label=<{}>];",
+            html(&note)
+        );
+    }
 
     // Nodes in order of first appearance in the rows.
     let mut emitted: Vec<String> = Vec::new();

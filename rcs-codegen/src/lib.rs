@@ -21,6 +21,7 @@
 pub mod config;
 pub mod diff;
 pub mod dot;
+mod every_cycle;
 pub mod ident;
 pub mod rust;
 pub mod rustfmt;

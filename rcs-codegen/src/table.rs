@@ -53,6 +53,7 @@ pub fn controller_tables(ir: &Ir, ctrl: &Controller) -> String {
             subs.join(", ")
         }
     );
+    every_cycle(ir, ctrl, &mut out);
     for (ci, cmd) in ctrl.commands.iter().enumerate() {
         let Some(pid) = cmd.plan else { continue };
         let plan = &ctrl.plans[pid.index()];
@@ -129,4 +130,30 @@ pub fn controller_tables(ir: &Ir, ctrl: &Controller) -> String {
         out.push('\n');
     }
     out
+}
+
+/// Status fields and `pre`/`post` jobs, before the tables (nothing for a
+/// controller without them).
+fn every_cycle(ir: &Ir, ctrl: &Controller, out: &mut String) {
+    let fields = crate::every_cycle::status_field_lines(ir, ctrl);
+    if !fields.is_empty() {
+        let list: Vec<String> = fields.iter().map(|f| code(f)).collect();
+        let _ = writeln!(
+            out,
+            "Status fields (published every cycle): {}.\n",
+            list.join(", ")
+        );
+    }
+    for (what, block) in [
+        ("Every cycle, before the rows (`pre`)", ctrl.pre.as_ref()),
+        ("Every cycle, after the row (`post`)", ctrl.post.as_ref()),
+    ] {
+        if block.is_some() {
+            let jobs: Vec<String> = crate::every_cycle::job_lines(ir, ctrl, block)
+                .iter()
+                .map(|j| code(j))
+                .collect();
+            let _ = writeln!(out, "{what}: {}.\n", jobs.join("; "));
+        }
+    }
 }

@@ -129,6 +129,41 @@ pub enum EntryKind {
     Plan(PlanDef),
     /// `const NAME: TYPE = EXPR` in a controller.
     Const(ConstDef),
+    /// `status NAME: TYPE = INIT`: a field of the controller's status buffer.
+    StatusField {
+        name: Name,
+        ty: TypeExpr,
+        init: Option<Expr>,
+    },
+    /// `pre { jobs }` or `post { jobs }`: jobs run every cycle.
+    EveryCycle(EveryCycleDef),
+}
+
+/// Which every-cycle block: before the rows (`pre`) or after them (`post`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Phase {
+    Pre,
+    Post,
+}
+
+impl Phase {
+    pub fn keyword(self) -> &'static str {
+        match self {
+            Phase::Pre => "pre",
+            Phase::Post => "post",
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct EveryCycleDef {
+    pub phase: Phase,
+    /// The keyword, where diagnostics about the block point.
+    pub keyword: Span,
+    pub jobs: Vec<Job>,
+    /// A `-> target` written after the block (always an error).
+    pub target: Option<Target>,
 }
 
 #[derive(Clone, Debug)]
@@ -211,6 +246,8 @@ pub enum Job {
         sub: Name,
         span: Span,
     },
+    /// `report ERROR(CODE)`: the status name and the error code.
+    ReportCode(Name, Name, Span),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]

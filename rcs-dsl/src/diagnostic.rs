@@ -59,11 +59,13 @@ pub enum Code {
     PlanVerbsDiffer,
     ForwardMismatch,
     Lint(Lint),
+    EveryCycleDecision,
+    EveryCycleTwice,
 }
 
 impl Code {
     /// Every hard-error code, in catalogue order (lints follow in [`Lint::ALL`]).
-    pub const ERRORS: [Code; 28] = [
+    pub const ERRORS: [Code; 30] = [
         Code::Syntax,
         Code::DuplicateDefinition,
         Code::UnknownName,
@@ -92,6 +94,8 @@ impl Code {
         Code::ReservedName,
         Code::PlanVerbsDiffer,
         Code::ForwardMismatch,
+        Code::EveryCycleDecision,
+        Code::EveryCycleTwice,
     ];
 
     pub fn name(self) -> &'static str {
@@ -125,6 +129,8 @@ impl Code {
             Code::PlanVerbsDiffer => "plan_verbs_differ",
             Code::ForwardMismatch => "forward_mismatch",
             Code::Lint(l) => l.name(),
+            Code::EveryCycleDecision => "every_cycle_decision",
+            Code::EveryCycleTwice => "every_cycle_twice",
         }
     }
 
@@ -187,6 +193,10 @@ impl Code {
             Code::Lint(Lint::StatusNeverReported) => {
                 "a supervisor waits for a status the subordinate never reports"
             }
+            Code::EveryCycleDecision => {
+                "a `pre` or `post` block sends, reports or changes state: decisions belong in the rows"
+            }
+            Code::EveryCycleTwice => "a controller has two `pre` or two `post` blocks",
         }
     }
 

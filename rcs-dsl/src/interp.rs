@@ -20,6 +20,7 @@ use crate::arith::truthy;
 pub use crate::arith::{checked, float_to_int, round, wrap};
 pub use rcs_runtime::driver::Value;
 
+mod every_cycle;
 /// `X <- cmd`: the command a forward sends.
 mod verbs;
 
@@ -132,6 +133,9 @@ struct SubState {
     link: SubordinateLink,
     status: Stamped<StatusBuffer>,
     view: SubordinateView,
+    /// The subordinate's status fields as last published, by its var id
+    /// (zero until it publishes).
+    fields: Vec<(VarId, Value)>,
 }
 
 /// One controller, interpreted.
@@ -177,10 +181,11 @@ impl<'ir> Interpreter<'ir> {
             subs: c
                 .subordinates
                 .iter()
-                .map(|_| SubState {
+                .map(|sub| SubState {
                     link: SubordinateLink::new(),
                     status: Stamped::default(),
                     view: SubordinateView::default(),
+                    fields: every_cycle::zero_fields(ir, *sub),
                 })
                 .collect(),
             condition_calls: None,
@@ -266,11 +271,15 @@ impl<'ir> Interpreter<'ir> {
         if self.bk.new_command() {
             self.active_params = params;
         }
-        // 4. Decide.
+        // 3b. Pre-process, with or without an active plan.
         let mut sent = Vec::new();
+        self.every_cycle(self.ctrl.pre.as_ref(), hooks);
+        // 4. Decide.
         if self.bk.is_active() {
             self.decide(hooks, &mut sent);
         }
+        // 4b. Post-process, after the row or none.
+        self.every_cycle(self.ctrl.post.as_ref(), hooks);
         // 5. Write (the record), 6. account.
         let record = CycleRecord {
             cycle: self.cycle,
@@ -369,6 +378,9 @@ impl<'ir> Interpreter<'ir> {
                 let args: Vec<Value> = args.iter().map(|a| self.eval(a, hooks)).collect();
                 self.send(*sub, *command, args, sent);
             }
+            Job::Report {
+                error: Some(code), ..
+            } => self.bk.report_error(ErrorCode::custom(code.0 as u16)),
             Job::Report { status, .. } => self.bk.report(Status(status.0 as u16)),
             Job::Call(e) => {
                 self.eval(e, hooks);
@@ -494,6 +506,7 @@ impl<'ir> Interpreter<'ir> {
                 let ty = args.first().map_or(&e.ty, |a| &a.ty);
                 crate::builtin::apply(*b, &values, ty)
             }
+            ExprKind::SubField(c, v) => self.sub_field(*c, *v),
         }
     }
 
@@ -697,6 +710,27 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
 
     fn last_sent(&mut self, sub: &str) -> Result<u32, rcs_runtime::driver::DriveError> {
         Ok(self.interp.last_sent(self.sub_index(sub)?))
+    }
+
+    fn write_sub_field(
+        &mut self,
+        sub: &str,
+        field: &str,
+        value: &Value,
+    ) -> Result<(), rcs_runtime::driver::DriveError> {
+        let c = self.interp.controller();
+        // An unknown subordinate and an unknown field read alike: `X.NAME`.
+        let unknown =
+            || rcs_runtime::driver::unknown(&c.name, "status field", &format!("{sub}.{field}"));
+        let i = self.sub_index(sub).map_err(|_| unknown())?;
+        let s = self.ir.controller(c.subordinates[i]);
+        let (id, var) = s
+            .status_fields()
+            .find(|(_, v)| v.name == field)
+            .ok_or_else(unknown)?;
+        let v = self.typed(&var.ty, &format!("{sub}.{field}"), value)?;
+        self.interp.write_sub_field(i, id, v);
+        Ok(())
     }
 
     fn cycle(&mut self) -> rcs_runtime::driver::Record {

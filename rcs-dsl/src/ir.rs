@@ -260,6 +260,39 @@ pub struct Controller {
     /// Where each `reads`/`writes` buffer is declared (its name), for diagnostics.
     #[serde(skip)]
     pub buffer_spans: Vec<(BufferId, Span)>,
+    /// `pre { … }`: jobs run every cycle before the rows (step 3b).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pre: Option<EveryCycle>,
+    /// `post { … }`: jobs run every cycle after the row, or none (step 4b).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub post: Option<EveryCycle>,
+}
+
+/// The jobs of a `pre` or `post` block: assignments and hook calls only
+/// (checked when lowering).
+#[derive(Clone, Debug, Serialize)]
+pub struct EveryCycle {
+    pub jobs: Vec<Job>,
+    /// The keyword (`pre` or `post`).
+    pub span: Span,
+}
+
+impl Controller {
+    /// The controller's status fields (vars published in its status
+    /// buffer), with their var ids, in declaration order.
+    pub fn status_fields(&self) -> impl Iterator<Item = (VarId, &Var)> {
+        self.vars
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.status_field)
+            .map(|(i, v)| (VarId(i as u32), v))
+    }
+
+    /// The `pre` and `post` jobs, in run order (for checks that look at
+    /// every job of the controller).
+    pub fn every_cycle_jobs(&self) -> impl Iterator<Item = &Job> {
+        self.pre.iter().chain(&self.post).flat_map(|b| &b.jobs)
+    }
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -302,6 +335,10 @@ pub struct Var {
     /// `None`: the type's zero value.
     pub init: Option<Expr>,
     pub span: Span,
+    /// Declared `status NAME: TYPE`: a var that step 5 also publishes in
+    /// the controller's status buffer, read by its supervisor as `X.NAME`.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub status_field: bool,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -435,6 +472,10 @@ pub enum Job {
     Report {
         status: StatusId,
         span: Span,
+        /// `report ERROR(CODE)`: the code (`None` for every other status,
+        /// and for a bare `report ERROR`).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        error: Option<ErrorId>,
     },
     /// A hook called for its effect; `call` is an `ExprKind::Call`.
     Call(Expr),
@@ -522,6 +563,9 @@ pub enum ExprKind {
     /// A built-in function (`abs`, `sqrt`, …): pure, arguments of one type
     /// (see [`crate::builtin`]).
     Builtin(crate::builtin::Builtin, Vec<Expr>),
+    /// `X.NAME`: status field `NAME` (a var of subordinate X) as X last
+    /// published it, whatever serial X echoes (not through the handshake).
+    SubField(CtrlId, VarId),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -616,13 +660,26 @@ impl Row {
         if let Condition::When(c) = &self.cond {
             c.visit(f);
         }
-        for j in &self.jobs {
-            match j {
-                Job::Assign { value, .. } => value.visit(f),
-                Job::Send { args, .. } => args.iter().for_each(|a| a.visit(f)),
-                Job::Call(e) => e.visit(f),
-                Job::Report { .. } | Job::Forward { .. } => {}
-            }
+        visit_job_exprs(&self.jobs, f);
+    }
+}
+
+impl EveryCycle {
+    /// Every expression of the block's jobs, in order.
+    pub fn visit_exprs(&self, f: &mut dyn FnMut(&Expr)) {
+        visit_job_exprs(&self.jobs, f);
+    }
+}
+
+/// Every expression of `jobs`, in order (assignment targets are places,
+/// not expressions, and are not visited).
+pub fn visit_job_exprs(jobs: &[Job], f: &mut dyn FnMut(&Expr)) {
+    for j in jobs {
+        match j {
+            Job::Assign { value, .. } => value.visit(f),
+            Job::Send { args, .. } => args.iter().for_each(|a| a.visit(f)),
+            Job::Call(e) => e.visit(f),
+            Job::Report { .. } | Job::Forward { .. } => {}
         }
     }
 }

@@ -98,6 +98,12 @@ impl<'a> Printer<'a> {
                 out.push('.');
                 out.push_str(prop.name());
             }
+            ExprKind::SubField(c, v) => {
+                let sub = &self.ir.controllers[c.index()];
+                out.push_str(&sub.name);
+                out.push('.');
+                out.push_str(&sub.vars[v.index()].name);
+            }
             ExprKind::Unary(op, x) => {
                 out.push(if *op == UnOp::Not { '!' } else { '-' });
                 self.write(x, UNARY, out);
@@ -179,6 +185,17 @@ impl<'a> Printer<'a> {
                         .collect();
                     format!("{} <- {}({})", target.name, cmd.name, args.join(", "))
                 }
+            }
+            Job::Report {
+                status,
+                error: Some(code),
+                ..
+            } => {
+                format!(
+                    "report {}({})",
+                    self.ctrl.statuses[status.index()].name,
+                    self.ctrl.errors[code.index()].name
+                )
             }
             Job::Report { status, .. } => {
                 format!("report {}", self.ctrl.statuses[status.index()].name)

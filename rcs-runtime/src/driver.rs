@@ -330,6 +330,19 @@ pub trait Driven {
     fn last_sent(&mut self, sub: &str) -> Result<u32, DriveError>;
     /// One control cycle.
     fn cycle(&mut self) -> Record;
+    /// Subordinate `sub` publishes `value` for its status field `field`
+    /// (`status NAME: TYPE`), read from the next cycle on as `sub.field`
+    /// whatever serial its status buffer echoes. A controller whose
+    /// subordinates have no status fields refuses every name. An unknown
+    /// subordinate or field is `unknown(self, "status field", "sub.field")`.
+    fn write_sub_field(&mut self, sub: &str, field: &str, value: &Value) -> Result<(), DriveError> {
+        let _ = value;
+        Err(unknown(
+            self.name(),
+            "status field",
+            &format!("{sub}.{field}"),
+        ))
+    }
 }
 
 /// One request of the driver protocol: [`serve`] reads them as JSON lines
@@ -395,6 +408,15 @@ pub enum Request {
     },
     /// [`Driven::cycle`].
     Cycle,
+    /// [`Driven::write_sub_field`].
+    WriteSubField {
+        /// The subordinate.
+        sub: String,
+        /// Its status field.
+        field: String,
+        /// The value it publishes.
+        value: Value,
+    },
 }
 
 /// The answer to one [`Request`].
@@ -468,6 +490,9 @@ fn answer(d: &mut dyn Driven, request: Request) -> Response {
         Request::WriteSubStatus { sub, status } => done(d.write_sub_status(&sub, status)),
         Request::LastSent { sub } => serial(d.last_sent(&sub)),
         Request::Cycle => Response::Record(d.cycle()),
+        Request::WriteSubField { sub, field, value } => {
+            done(d.write_sub_field(&sub, &field, &value))
+        }
     }
 }
 
@@ -613,6 +638,14 @@ impl<R: std::io::BufRead, W: std::io::Write> Driven for Remote<R, W> {
             Some(Response::Record(r)) => r,
             _ => Record::default(),
         }
+    }
+
+    fn write_sub_field(&mut self, sub: &str, field: &str, value: &Value) -> Result<(), DriveError> {
+        self.unit(&Request::WriteSubField {
+            sub: sub.to_string(),
+            field: field.to_string(),
+            value: value.clone(),
+        })
     }
 }
 

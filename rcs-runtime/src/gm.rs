@@ -188,6 +188,14 @@ pub fn status_buffer_name(ctrl: &str) -> String {
     format!("{ctrl}.status")
 }
 
+/// The Global Memory name of the buffer holding controller `ctrl`'s status
+/// fields (`status NAME: TYPE`): `CTRL.status_fields`. Written in step 5
+/// beside the status buffer; a supervisor reads it whatever serial the
+/// status buffer echoes.
+pub fn status_fields_buffer_name(ctrl: &str) -> String {
+    format!("{ctrl}.status_fields")
+}
+
 fn check_type<T: 'static>(name: &str, e: &Entry) -> Result<(), SetupError> {
     if e.type_id == TypeId::of::<T>() {
         Ok(())

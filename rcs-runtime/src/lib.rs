@@ -195,7 +195,8 @@ pub use exec::{
     ExecutiveStats, Heartbeat, Wait,
 };
 pub use gm::{
-    command_buffer_name, status_buffer_name, BufferData, GlobalMemory, Reader, Stamped, Writer,
+    command_buffer_name, status_buffer_name, status_fields_buffer_name, BufferData, GlobalMemory,
+    Reader, Stamped, Writer,
 };
 pub use handshake::{
     next_serial, Command, CommandBuffer, ErrorCode, RowId, StateId, Status, StatusBuffer,

@@ -284,10 +284,21 @@ impl Bookkeeping {
     }
 
     /// `report S`: set the status (it stays until the next report, `Done`,
-    /// `Error` or new command).
+    /// `Error` or new command) and clear any error code a `report
+    /// ERROR(CODE)` left; the plan goes on. `report DONE` makes a
+    /// supervisor's `X.done` true while the plan keeps running.
     #[inline]
     pub fn report(&mut self, status: Status) {
         self.status = status;
+        self.error = ErrorCode::NONE;
+    }
+
+    /// `report ERROR(CODE)`: status `ERROR` with `code`, and the plan goes
+    /// on (unlike `-> Error(CODE)`, which ends it).
+    #[inline]
+    pub fn report_error(&mut self, code: ErrorCode) {
+        self.status = Status::ERROR;
+        self.error = code;
     }
 
     /// Step 6: count the cycle (`state_cycles` and `plan_cycles` grow by

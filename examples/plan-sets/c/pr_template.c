@@ -29,10 +29,13 @@ typedef struct { unsigned echo_num; unsigned status; unsigned state; } PR_STATUS
 typedef struct { unsigned command_num; unsigned command; double rpm; } TB_COMMAND;
 typedef struct { unsigned echo_num; unsigned status; } TB_STATUS;
 typedef struct { int direction; double speed; } SHIP;
+/* PR's status data, published every cycle beside its status. */
+typedef struct { double ordered_rpm; double ship_speed; } PR_STATUS_FIELDS;
 
 typedef struct {
     PR_COMMAND pr_ci;
     PR_STATUS pr_so;
+    PR_STATUS_FIELDS pr_sf;
     TB_COMMAND tb_ci;
     TB_STATUS tb_so;
     SHIP ship;
@@ -44,6 +47,7 @@ static GLOBAL_MEMORY *G = &G_MEM;
 /* PR's local copies of its interface buffers. */
 static PR_COMMAND pr_ci;
 static PR_STATUS pr_so;
+static PR_STATUS_FIELDS pr_sf;
 static TB_COMMAND tb_co;
 static TB_STATUS tb_si;
 static SHIP ship;
@@ -73,6 +77,9 @@ static void pr_pre_process(void)
     if (tb_si.echo_num != tb_co.command_num)
         tb_si.status = 1;
 }
+
+/* Every cycle, before the decision: the ship speed as read. */
+static void pr_every_cycle_pre(void) { pr_sf.ship_speed = ship.speed; }
 
 static void pr_check_if_new_command(void)
 {
@@ -147,7 +154,9 @@ static void pr_decision_process(void)
 static void pr_post_process(void)
 {
     pr_so.state = (unsigned)pr_cur_state;
+    pr_sf.ordered_rpm = prop_speed;
     COPY_BUFFER(&(G->pr_so), &pr_so, sizeof(PR_STATUS));
+    COPY_BUFFER(&(G->pr_sf), &pr_sf, sizeof(PR_STATUS_FIELDS));
     COPY_BUFFER(&(G->tb_ci), &tb_co, sizeof(TB_COMMAND));
 }
 
@@ -156,6 +165,7 @@ void pr_c_controller(void)
 {
     pr_pre_process();
     pr_check_if_new_command();
+    pr_every_cycle_pre();
     pr_decision_process();
     pr_post_process();
 }
@@ -166,6 +176,7 @@ void pr_c_reset(void)
     memset(G, 0, sizeof(*G));
     memset(&pr_ci, 0, sizeof(pr_ci));
     memset(&pr_so, 0, sizeof(pr_so));
+    memset(&pr_sf, 0, sizeof(pr_sf));
     memset(&tb_co, 0, sizeof(tb_co));
     memset(&tb_si, 0, sizeof(tb_si));
     memset(&ship, 0, sizeof(ship));
@@ -195,3 +206,6 @@ void pr_c_world(double ship_speed)
 unsigned pr_c_state(void) { return G->pr_so.state; }
 unsigned pr_c_status(void) { return G->pr_so.status; }
 double pr_c_rpm(void) { return G->tb_ci.rpm; }
+/* Harness: PR's status fields. */
+double pr_c_ordered_rpm(void) { return G->pr_sf.ordered_rpm; }
+double pr_c_ship_speed(void) { return G->pr_sf.ship_speed; }

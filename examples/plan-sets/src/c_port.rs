@@ -13,6 +13,8 @@ extern "C" {
     fn pr_c_state() -> u32;
     fn pr_c_status() -> u32;
     fn pr_c_rpm() -> f64;
+    fn pr_c_ordered_rpm() -> f64;
+    fn pr_c_ship_speed() -> f64;
 }
 
 static TAKEN: AtomicBool = AtomicBool::new(false);
@@ -62,6 +64,12 @@ impl CPropulsion {
     pub fn rpm(&self) -> f64 {
         // SAFETY: see `take`.
         unsafe { pr_c_rpm() }
+    }
+
+    /// PR's status fields: the RPM last ordered and the ship speed read.
+    pub fn status_fields(&self) -> (f64, f64) {
+        // SAFETY: see `take`.
+        unsafe { (pr_c_ordered_rpm(), pr_c_ship_speed()) }
     }
 }
 

@@ -1,7 +1,9 @@
 //! Propulsion (PR) written by hand over rcs-runtime: the plans of Appendix
 //! C with the same Global Memory buffers and runtime calls as the generated
 //! controller, in the shape an engineer would write it (one `match` on the
-//! state, the speed error computed once per cycle). The benchmark's yardstick.
+//! state, the speed error computed once per cycle), publishing the same
+//! status fields (ordered RPM, ship speed) every cycle. The benchmark's
+//! yardstick.
 
 use rcs_runtime::{
     Bookkeeping, Command, CommandBuffer, Controller, CycleContext, GlobalMemory, Reader,
@@ -76,6 +78,14 @@ impl Command for TbCommand {
     }
 }
 
+/// PR's status fields, as the generated `pr::StatusFields` (same Global
+/// Memory buffer, `PR.status_fields`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PrStatusFields {
+    pub ordered_rpm: f64,
+    pub ship_speed: f64,
+}
+
 const AT_GOAL: Status = Status::custom(0);
 const S1: StateId = 1;
 const S2: StateId = 2;
@@ -100,26 +110,31 @@ pub struct Propulsion {
     bk: Bookkeeping,
     cmd_in: Reader<CommandBuffer<PrCommand>>,
     status_out: Writer<StatusBuffer>,
+    fields_out: Writer<PrStatusFields>,
     ship_in: Reader<Ship>,
     tb: Subordinate<TbCommand>,
     cmd: PrCommand,
     ship: Ship,
     rpm: f64,
+    fields: PrStatusFields,
 }
 
 impl Propulsion {
     pub fn new(gm: &GlobalMemory) -> Result<Self, SetupError> {
         gm.declare_controller::<PrCommand>("PR")?;
         gm.declare::<Ship>("ship")?;
+        gm.declare::<PrStatusFields>(&rcs_runtime::status_fields_buffer_name("PR"))?;
         Ok(Self {
             bk: Bookkeeping::new(3),
             cmd_in: gm.command_reader("PR")?,
             status_out: gm.status_writer("PR")?,
+            fields_out: gm.writer(&rcs_runtime::status_fields_buffer_name("PR"))?,
             ship_in: gm.reader("ship")?,
             tb: Subordinate::connect(gm, "TB")?,
             cmd: PrCommand::default(),
             ship: Ship::default(),
             rpm: 0.0,
+            fields: PrStatusFields::default(),
         })
     }
 
@@ -192,6 +207,8 @@ impl Controller for Propulsion {
         if self.bk.new_command() {
             self.cmd = cmd.command;
         }
+        // pre: the ship speed as read this cycle.
+        self.fields.ship_speed = self.ship.speed;
         if self.bk.is_active() {
             match self.cmd {
                 PrCommand::Init => {
@@ -204,7 +221,10 @@ impl Controller for Propulsion {
                 PrCommand::Ahead { speed } => self.ahead(speed, tb),
             }
         }
+        // post: the RPM last ordered.
+        self.fields.ordered_rpm = self.rpm;
         self.status_out.write(self.bk.status_buffer(), ctx.cycle);
+        self.fields_out.write(self.fields, ctx.cycle);
         self.tb.flush(ctx.cycle);
         self.bk.end_cycle();
     }

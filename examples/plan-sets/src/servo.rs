@@ -16,8 +16,9 @@ use std::time::{Duration, Instant};
 pub const GOAL: f64 = 10.0;
 pub const SHIP_SPEEDS: [f64; 3] = [9.0, 10.0, 11.0];
 
-/// What one cycle of PR produced: state, status, last RPM sent to TB.
-pub type Observation = (u16, u16, f64);
+/// What one cycle of PR produced: state, status, last RPM sent to TB, and
+/// its status fields (RPM ordered, ship speed).
+pub type Observation = (u16, u16, f64, (f64, f64));
 
 /// The generated controller's hooks: the same model as `hand`.
 #[derive(Debug, Default)]
@@ -59,6 +60,7 @@ pub struct RustLoop<
     P: rcs_runtime::Command,
     T: rcs_runtime::Command,
     S: Copy + Default + Send + 'static,
+    F: Copy + Default + Send + 'static,
 > {
     pub ctrl: C,
     operator: Operator<P>,
@@ -68,6 +70,8 @@ pub struct RustLoop<
     make_ship: fn(f64) -> S,
     rpm_of: fn(&T) -> f64,
     pr_status: Reader<StatusBuffer>,
+    pr_fields: Reader<F>,
+    fields_of: fn(&F) -> (f64, f64),
     ctx: CycleContext,
     turn: usize,
 }
@@ -77,7 +81,8 @@ impl<
         P: rcs_runtime::Command,
         T: rcs_runtime::Command,
         S: Copy + Default + Send + 'static,
-    > RustLoop<C, P, T, S>
+        F: Copy + Default + Send + 'static,
+    > RustLoop<C, P, T, S, F>
 {
     /// One cycle: the world answers, then PR runs, called the way the
     /// runtime's `Executive` calls every controller: through
@@ -124,6 +129,7 @@ impl<
             s.state,
             s.status.0,
             (self.rpm_of)(&self.tb_command.read().value.command),
+            (self.fields_of)(&self.pr_fields.read().value),
         )
     }
 
@@ -134,6 +140,7 @@ impl<
         ctrl: C,
         make_ship: fn(f64) -> S,
         rpm_of: fn(&T) -> f64,
+        fields_of: fn(&F) -> (f64, f64),
         first: P,
     ) -> Result<Self, SetupError> {
         gm.declare_controller::<T>("TB")?;
@@ -146,6 +153,8 @@ impl<
             make_ship,
             rpm_of,
             pr_status: gm.status_reader("PR")?,
+            pr_fields: gm.reader(&rcs_runtime::status_fields_buffer_name("PR"))?,
+            fields_of,
             ctx: context(),
             turn: 0,
         };
@@ -154,9 +163,15 @@ impl<
     }
 }
 
-pub type GeneratedLoop =
-    RustLoop<sub::pr::Controller<Model>, sub::pr::Command, sub::tb::Command, sub::types::Ship>;
-pub type HandLoop = RustLoop<hand::Propulsion, hand::PrCommand, hand::TbCommand, hand::Ship>;
+pub type GeneratedLoop = RustLoop<
+    sub::pr::Controller<Model>,
+    sub::pr::Command,
+    sub::tb::Command,
+    sub::types::Ship,
+    sub::pr::StatusFields,
+>;
+pub type HandLoop =
+    RustLoop<hand::Propulsion, hand::PrCommand, hand::TbCommand, hand::Ship, hand::PrStatusFields>;
 
 /// The generated PR, commanded AHEAD(GOAL).
 pub fn generated() -> Result<GeneratedLoop, SetupError> {
@@ -173,6 +188,7 @@ pub fn generated() -> Result<GeneratedLoop, SetupError> {
             sub::tb::Command::Ahead { rpm } => *rpm,
             _ => 0.0,
         },
+        |f| (f.ordered_rpm, f.ship_speed),
         sub::pr::Command::Ahead { speed: GOAL },
     )
 }
@@ -192,6 +208,7 @@ pub fn hand_written() -> Result<HandLoop, SetupError> {
             hand::TbCommand::Ahead { rpm } => *rpm,
             _ => 0.0,
         },
+        |f| (f.ordered_rpm, f.ship_speed),
         hand::PrCommand::Ahead { speed: GOAL },
     )
 }
@@ -221,6 +238,7 @@ impl CLoop {
             self.pr.state() as u16,
             self.pr.status() as u16,
             self.pr.rpm(),
+            self.pr.status_fields(),
         )
     }
 }

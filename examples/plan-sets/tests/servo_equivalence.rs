@@ -1,6 +1,7 @@
 //! The generated propulsion controller, the hand-written one and the C port
 //! of the methodology's template run Appendix C's servo loop identically,
-//! cycle by cycle: same state, same status, same RPM sent to the turbine.
+//! cycle by cycle: same state, same status, same RPM sent to the turbine,
+//! same status fields (RPM ordered, ship speed) published every cycle.
 
 use rcs_plan_sets::servo;
 
@@ -32,6 +33,11 @@ fn generated_hand_written_and_c_agree_on_the_servo_loop() {
     );
     let first_rpm = servo::GOAL * 10.0;
     assert_ne!(generated.observe().2, 0.0);
+    // The status fields are published: the RPM ordered is the RPM sent,
+    // and the ship speed is one the world wrote.
+    let (ordered, speed) = generated.observe().3;
+    assert_eq!(ordered, generated.observe().2, "ordered_rpm follows rpm");
+    assert!(servo::SHIP_SPEEDS.contains(&speed), "ship_speed {speed}");
     assert!(
         (generated.observe().2 - first_rpm).abs() <= 2.0,
         "RPM stays near the model's {first_rpm}"

@@ -393,6 +393,18 @@ pub(crate) fn module(
         }
     };
 
+    let super::every_cycle::Parts {
+        items: every_cycle_items,
+        data_field: sub_fields_data,
+        handles: every_cycle_handles,
+        declares: every_cycle_declares,
+        inits: every_cycle_inits,
+        read: sub_fields_read,
+        pre: pre_jobs,
+        post: post_jobs,
+        write: status_fields_write,
+    } = super::every_cycle::parts(ir, names, ci, comments);
+
     let verb_count_lit = proc_macro2::Literal::usize_unsuffixed(verb_count);
     // The six steps of a cycle (docs/semantics.md), as comments in the output.
     let step1 = comments.marker(
@@ -507,6 +519,8 @@ pub(crate) fn module(
             pub struct Vars { #(#var_docs pub #var_fields: #var_tys),* }
             #vars_default
 
+            #every_cycle_items
+
             /// Everything a cycle works on. Hooks see it read-only.
             #[derive(Clone, Copy, Debug, Default, PartialEq)]
             pub struct Data {
@@ -520,6 +534,7 @@ pub(crate) fn module(
                 pub vars: Vars,
                 /// The buffers written, copied out at the end of the cycle.
                 pub writes: Writes,
+                #sub_fields_data
             }
 
             /// The controller: its data, its plans' bookkeeping and its Global Memory handles.
@@ -533,6 +548,7 @@ pub(crate) fn module(
                 #(#read_handles: rt::Reader<#read_tys>,)*
                 #(#write_handles: rt::Writer<#write_tys>,)*
                 #(#sub_handles: rt::Subordinate<super::#sub_modules::Command>,)*
+                #every_cycle_handles
             }
 
             impl<H: Hooks> Controller<H> {
@@ -543,6 +559,7 @@ pub(crate) fn module(
                     gm.declare_controller::<Command>(NAME)?;
                     #(gm.declare::<#read_tys>(#read_names)?;)*
                     #(gm.declare::<#write_tys>(#write_names)?;)*
+                    #every_cycle_declares
                     Ok(Self {
                         hooks,
                         data: Data::default(),
@@ -552,6 +569,7 @@ pub(crate) fn module(
                         #(#read_handles: gm.reader(#read_names)?,)*
                         #(#write_handles: gm.writer(#write_names)?,)*
                         #(#sub_handles: rt::Subordinate::connect(gm, #sub_names)?,)*
+                        #every_cycle_inits
                     })
                 }
 
@@ -586,6 +604,7 @@ pub(crate) fn module(
                     #step1
                     let command = self.command_in.read().value;
                     #(self.data.reads.#read_fields = self.#read_handles.read().value;)*
+                    #sub_fields_read
                     #step2
                     let subs = Subs { #(#sub_fields: self.#sub_handles.read()),* };
                     self.data.subs = subs;
@@ -594,12 +613,15 @@ pub(crate) fn module(
                     if self.bk.new_command() {
                         self.data.command = command.command;
                     }
+                    #pre_jobs
                     #step4
                     if self.bk.is_active() {
                         self.decide(subs);
                     }
+                    #post_jobs
                     #step5
                     self.status_out.write(self.bk.status_buffer(), ctx.cycle);
+                    #status_fields_write
                     #(self.#write_handles.write(self.data.writes.#write_fields, ctx.cycle);)*
                     #(self.#sub_handles.flush(ctx.cycle);)*
                     #step6

@@ -288,6 +288,8 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
             })*),
         )
     };
+    let (fields_handles, fields_inits, write_sub_field) =
+        super::every_cycle::driver_parts(ir, names, ci);
     let var_match_body = by_name("var", "var", var_match);
     let write_match_body = by_name("buffer", "write buffer", write_match);
     let read_match_body = by_name("buffer", "read buffer", read_match);
@@ -310,6 +312,7 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
             #(#read_handles: rt::Writer<#read_tys>,)*
             #(#sub_cmd: rt::Reader<rt::CommandBuffer<super::#sub_modules::Command>>,)*
             #(#sub_status: rt::Writer<rt::StatusBuffer>,)*
+            #fields_handles
             cycle: u64,
         }
 
@@ -324,6 +327,7 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
                     #(#read_handles: gm.writer(#read_names)?,)*
                     #(#sub_cmd: gm.command_reader(#sub_names)?,)*
                     #(#sub_status: gm.status_writer(#sub_names)?,)*
+                    #fields_inits
                     cycle: 0,
                 })
             }
@@ -365,6 +369,8 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
             fn last_sent(&mut self, sub: &str) -> Result<u32, #dv::DriveError> {
                 #sub_last_body
             }
+
+            #write_sub_field
 
             fn cycle(&mut self) -> #dv::Record {
                 #before

@@ -303,6 +303,9 @@ impl Gen<'_> {
                     SubProp::StaleCycles => quote!(subs.#id.stale_cycles),
                 })
             }
+            ExprKind::SubField(sub, var) => Code::atom(super::every_cycle::sub_field(
+                self.names, self.ctrl, self.ci, *sub, *var,
+            )),
             ExprKind::Unary(op, x) => {
                 let c = self.expr(x);
                 match (op, &x.ty) {
@@ -547,6 +550,12 @@ impl Gen<'_> {
             } => {
                 let vals: Vec<TokenStream> = args.iter().map(|a| self.expr(a).ts).collect();
                 self.send(*sub, *command, &vals)
+            }
+            Job::Report {
+                error: Some(code), ..
+            } => {
+                let c = &self.cn().error_consts[code.index()];
+                quote!(self.bk.report_error(error::#c);)
             }
             Job::Report { status, .. } => {
                 let c = &self.cn().status_consts[status.index()];

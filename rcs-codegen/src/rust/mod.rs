@@ -7,6 +7,7 @@
 mod builtins;
 mod controller;
 mod driver;
+mod every_cycle;
 mod expr;
 mod names;
 mod plan;

@@ -470,9 +470,11 @@ impl PlanAnalysis<'_> {
                     Leaf::Var(..) => !given.iter().any(|(g, _)| *g == l),
                     Leaf::Buffer(b, _) => self.ctrl.writes.contains(b),
                     Leaf::StateCycles | Leaf::PlanCycles | Leaf::SubStale(_) => true,
-                    Leaf::NewCommand | Leaf::Param(..) | Leaf::Call(..) | Leaf::SubStatus(_) => {
-                        false
-                    }
+                    Leaf::NewCommand
+                    | Leaf::Param(..)
+                    | Leaf::Call(..)
+                    | Leaf::SubStatus(_)
+                    | Leaf::SubField(..) => false,
                 };
             }
         });

@@ -515,6 +515,10 @@ impl<'ir> PlanAnalysis<'ir> {
                 let var = &self.ctrl.vars[v.index()];
                 self.path(var.name.clone(), &var.ty, steps)
             }
+            Leaf::SubField(c, v, steps) => {
+                let var = &self.ir.controller(*c).vars[v.index()];
+                self.path(format!("{}.{}", sub(*c), var.name), &var.ty, steps)
+            }
             Leaf::Buffer(b, steps) => {
                 let buf = &self.ir.buffers[b.index()];
                 let fields = &self.ir.buffer_types[buf.ty.index()].fields;
@@ -576,18 +580,17 @@ impl<'ir> PlanAnalysis<'ir> {
     }
 }
 
-/// The vars some job of some plan of `ctrl` assigns.
+/// The vars some job of some plan of `ctrl`, or of its `pre`/`post`
+/// blocks, assigns. A var `pre` assigns changes every cycle whether or
+/// not a row fires, so it is never a value fixed for the command.
 fn assigned_vars(ctrl: &Controller) -> Vec<crate::ir::VarId> {
     let mut vars = Vec::new();
-    for p in &ctrl.plans {
-        for r in &p.rows {
-            for j in &r.jobs {
-                if let crate::ir::Job::Assign { place, .. } = j {
-                    if let crate::ir::PlaceRoot::Var(v) = place.root {
-                        if !vars.contains(&v) {
-                            vars.push(v);
-                        }
-                    }
+    let rows = ctrl.plans.iter().flat_map(|p| &p.rows);
+    for j in rows.flat_map(|r| &r.jobs).chain(ctrl.every_cycle_jobs()) {
+        if let crate::ir::Job::Assign { place, .. } = j {
+            if let crate::ir::PlaceRoot::Var(v) = place.root {
+                if !vars.contains(&v) {
+                    vars.push(v);
                 }
             }
         }

@@ -285,6 +285,9 @@ impl PlanAnalysis<'_> {
                 Leaf::Param(p, steps) if first => {
                     *at_path_mut(params.get_mut(p.index())?, steps)? = v.clone();
                 }
+                // Runs do not set subordinates' status fields yet: such a
+                // witness gets no run (and so no finding leans on one).
+                Leaf::SubField(..) => return None,
                 _ => {}
             }
         }

@@ -4,8 +4,8 @@
 //! counter, a command parameter, a var or buffer field (through constant
 //! fields and indices), a hook call's result (one value per distinct call
 //! and cycle: the backends evaluate each distinct call once per cycle), a
-//! subordinate's status as seen through the handshake, or its
-//! `stale_cycles`. An **atom** is a boolean sub-expression that is not
+//! subordinate's status as seen through the handshake, its
+//! `stale_cycles`, or one of its status fields (`X.NAME`, a free input). An **atom** is a boolean sub-expression that is not
 //! `&&`, `||`, `!` or a literal. An atom is **exact** when the analysis
 //! knows every point where its truth can change along its one leaf (a bool
 //! leaf itself, `leaf OP constant`, a subordinate's `done`/`executing`/
@@ -30,6 +30,9 @@ pub enum Leaf {
     /// A subordinate's status, through the handshake.
     SubStatus(CtrlId),
     SubStale(CtrlId),
+    /// A subordinate's status field (`X.NAME`), then constant projections:
+    /// an input the subordinate sets freely, like a `reads` buffer.
+    SubField(CtrlId, VarId, Vec<Step>),
 }
 
 /// A constant field or index on the way into a parameter, var or buffer.
@@ -225,6 +228,7 @@ pub fn as_leaf(e: &Expr) -> Option<Leaf> {
         ExprKind::CmdParam(_, p) => Leaf::Param(*p, Vec::new()),
         ExprKind::Var(v) => Leaf::Var(*v, Vec::new()),
         ExprKind::Buffer(b) => Leaf::Buffer(*b, Vec::new()),
+        ExprKind::SubField(c, v) => Leaf::SubField(*c, *v, Vec::new()),
         ExprKind::Field(x, f) => with_step(as_leaf(x)?, Step::Field(*f))?,
         ExprKind::Index(x, i) => with_step(as_leaf(x)?, Step::Index(*i))?,
         _ => return None,
@@ -244,6 +248,10 @@ fn with_step(leaf: Leaf, step: Step) -> Option<Leaf> {
         Leaf::Buffer(b, mut s) => {
             s.push(step);
             Leaf::Buffer(b, s)
+        }
+        Leaf::SubField(c, v, mut s) => {
+            s.push(step);
+            Leaf::SubField(c, v, s)
         }
         _ => return None,
     })
@@ -270,6 +278,7 @@ pub fn same_leaf(a: &Leaf, b: &Leaf) -> bool {
         (Leaf::Param(x, s), Leaf::Param(y, t)) => x == y && s == t,
         (Leaf::Var(x, s), Leaf::Var(y, t)) => x == y && s == t,
         (Leaf::Buffer(x, s), Leaf::Buffer(y, t)) => x == y && s == t,
+        (Leaf::SubField(c, x, s), Leaf::SubField(d, y, t)) => c == d && x == y && s == t,
         (Leaf::Call(h, xs), Leaf::Call(k, ys)) => {
             h == k && xs.len() == ys.len() && xs.iter().zip(ys).all(|(x, y)| same_expr(x, y))
         }

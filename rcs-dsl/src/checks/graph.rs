@@ -203,7 +203,9 @@ impl Analysis {
     /// `entry_missing`'s).
     pub fn is_dead_end(&self, p: &Plan, i: usize) -> bool {
         let dead = !self.leaves[i] || (i == 0 && self.s0_dead_on_return);
-        dead && self.reachable[i] && (i != 0 || p.rows.iter().any(|r| r.is_entry))
+        dead && self.reachable[i]
+            && (i != 0 || p.rows.iter().any(|r| r.is_entry))
+            && !super::report::reported_hold(p, i)
     }
 }
 
@@ -233,7 +235,7 @@ pub(crate) fn check_dead_ends(c: &Controller, p: &Plan, a: &Analysis, sink: &mut
 }
 
 pub(crate) fn check_no_done(ir: &Ir, c: &Controller, p: &Plan, a: &Analysis, sink: &mut Sink) {
-    if a.ends {
+    if a.ends || super::report::reports_any_outcome(p, &a.never_matches) {
         return;
     }
     let _ = ir;

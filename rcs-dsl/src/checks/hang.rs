@@ -30,6 +30,10 @@ pub(crate) fn check_incomplete_states(
         if graph.is_dead_end(p, hang.state.index()) {
             continue;
         }
+        // A state held after `report DONE`/`ERROR`: waiting there is the point.
+        if super::report::reported_hold(p, hang.state.index()) {
+            continue;
+        }
         let state = &p.states[hang.state.index()];
         let name = &state.name;
         let shown = shown_values(conditions, p, hang.state, &hang.given, &hang.path);

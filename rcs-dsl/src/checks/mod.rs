@@ -11,6 +11,7 @@ mod limits;
 mod loops;
 pub(crate) mod names;
 mod plan;
+mod report;
 mod usage;
 
 use crate::analysis::PlanAnalysis;

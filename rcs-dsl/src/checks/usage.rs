@@ -88,17 +88,21 @@ pub(crate) fn check_unused(ir: &Ir, sink: &mut Sink) {
         {
             mark(t, &mut enum_used, &mut btype_used);
         }
+        let mut mark_expr = |e: &crate::ir::Expr| {
+            if let ExprKind::Variant(en, _) = e.kind {
+                enum_used[en.index()] = true;
+            }
+            if let (ExprKind::Status(s), Type::Status(owner)) = (&e.kind, &e.ty) {
+                status_used[owner.index()][s.index()] = true;
+            }
+        };
         for p in &c.plans {
             for r in &p.rows {
-                r.visit_exprs(&mut |e| {
-                    if let ExprKind::Variant(en, _) = e.kind {
-                        enum_used[en.index()] = true;
-                    }
-                    if let (ExprKind::Status(s), Type::Status(owner)) = (&e.kind, &e.ty) {
-                        status_used[owner.index()][s.index()] = true;
-                    }
-                });
+                r.visit_exprs(&mut mark_expr);
             }
+        }
+        for b in c.pre.iter().chain(&c.post) {
+            b.visit_exprs(&mut mark_expr);
         }
     }
     for (ci, c) in ir.controllers.iter().enumerate() {
@@ -106,26 +110,44 @@ pub(crate) fn check_unused(ir: &Ir, sink: &mut Sink) {
         let mut hook_used = vec![false; c.hooks.len()];
         let mut error_used = vec![false; c.errors.len()];
         let mut buffer_used = vec![false; ir.buffers.len()];
-        for p in &c.plans {
-            for r in &p.rows {
-                if let Target::Error(Some(e)) = r.to {
-                    error_used[e.index()] = true;
-                }
-                r.visit_exprs(&mut |e| match &e.kind {
-                    ExprKind::Var(v) => var_used[v.index()] = true,
-                    ExprKind::Call(h, _) => hook_used[h.index()] = true,
-                    ExprKind::Buffer(b) => buffer_used[b.index()] = true,
-                    _ => {}
-                });
-                for j in &r.jobs {
-                    match j {
-                        Job::Assign { place, .. } => match place.root {
-                            PlaceRoot::Var(v) => var_used[v.index()] = true,
-                            PlaceRoot::Buffer(b) => buffer_used[b.index()] = true,
-                        },
-                        Job::Report { status, .. } => status_used[ci][status.index()] = true,
-                        _ => {}
+        // A status field is published every cycle: used even if no row reads it.
+        for (v, _) in c.status_fields() {
+            var_used[v.index()] = true;
+        }
+        // The rows' jobs, then the `pre`/`post` jobs.
+        let rows = c.plans.iter().flat_map(|p| &p.rows);
+        let blocks = rows
+            .map(|r| (&r.jobs, Some(r)))
+            .chain(c.pre.iter().chain(&c.post).map(|b| (&b.jobs, None)));
+        for (jobs, row) in blocks {
+            let mut mark_expr = |e: &crate::ir::Expr| match &e.kind {
+                ExprKind::Var(v) => var_used[v.index()] = true,
+                ExprKind::Call(h, _) => hook_used[h.index()] = true,
+                ExprKind::Buffer(b) => buffer_used[b.index()] = true,
+                _ => {}
+            };
+            match row {
+                Some(r) => {
+                    if let Target::Error(Some(e)) = r.to {
+                        error_used[e.index()] = true;
                     }
+                    r.visit_exprs(&mut mark_expr);
+                }
+                None => crate::ir::visit_job_exprs(jobs, &mut mark_expr),
+            }
+            for j in jobs {
+                match j {
+                    Job::Assign { place, .. } => match place.root {
+                        PlaceRoot::Var(v) => var_used[v.index()] = true,
+                        PlaceRoot::Buffer(b) => buffer_used[b.index()] = true,
+                    },
+                    Job::Report { status, error, .. } => {
+                        status_used[ci][status.index()] = true;
+                        if let Some(e) = error {
+                            error_used[e.index()] = true;
+                        }
+                    }
+                    _ => {}
                 }
             }
         }

@@ -137,6 +137,24 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                         ty: ty.unwrap_or(Type::Unit),
                         init: None,
                         span: name.span,
+                        status_field: false,
+                    });
+                }
+                ast::EntryKind::StatusField { name, ty, .. } => {
+                    // A reserved name is reported, and the field still
+                    // declared so that its uses do not cascade.
+                    super::every_cycle::status_field_name_free(name, diags);
+                    if !claim(name, "name", diags) {
+                        continue;
+                    }
+                    let ty = resolve_type(g, ty, diags);
+                    vars.push(Var {
+                        name: name.text.to_string(),
+                        docs: docs.clone(),
+                        ty: ty.unwrap_or(Type::Unit),
+                        init: None,
+                        span: name.span,
+                        status_field: true,
                     });
                 }
                 ast::EntryKind::Hook { name, params, ret } => {
@@ -168,6 +186,7 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
             }
         }
         g.scope.set(None);
+        super::every_cycle::check_status_value_clash(&vars, &statuses, diags);
         let ctrl = &mut ir.controllers[i];
         ctrl.commands = commands;
         ctrl.statuses = statuses;
@@ -207,6 +226,7 @@ pub(super) fn lower_controller_body(
     let diags = &mut diags;
     let mut inits = Vec::new();
     let mut plans: Vec<Plan> = Vec::new();
+    let (mut pre, mut post): (Option<EveryCycle>, Option<EveryCycle>) = (None, None);
     let mut plan_of: Vec<Option<PlanId>> = vec![None; ir.controllers[id.index()].commands.len()];
     {
         let ctrl = &ir.controllers[id.index()];
@@ -238,6 +258,11 @@ pub(super) fn lower_controller_body(
         for e in &c.entries {
             match &e.kind {
                 ast::EntryKind::Var {
+                    name,
+                    init: Some(init),
+                    ..
+                }
+                | ast::EntryKind::StatusField {
                     name,
                     init: Some(init),
                     ..
@@ -274,6 +299,15 @@ pub(super) fn lower_controller_body(
                     plans.push(plan);
                     cx.plan_verbs.clear();
                 }
+                ast::EntryKind::EveryCycle(def) => {
+                    cx.const_ctx = false;
+                    cx.plan_cmd = None;
+                    let slot = match def.phase {
+                        ast::Phase::Pre => &mut pre,
+                        ast::Phase::Post => &mut post,
+                    };
+                    cx.every_cycle(def, slot);
+                }
                 _ => {}
             }
         }
@@ -282,6 +316,8 @@ pub(super) fn lower_controller_body(
         inits,
         plans,
         plan_of,
+        pre,
+        post,
         diags: std::mem::take(diags),
     }
 }
@@ -295,6 +331,9 @@ pub(super) struct ControllerBody {
     plans: Vec<Plan>,
     /// Each command's plan, by the command's index.
     plan_of: Vec<Option<PlanId>>,
+    /// The `pre` and `post` blocks.
+    pre: Option<EveryCycle>,
+    post: Option<EveryCycle>,
     pub diags: Diagnostics,
 }
 
@@ -307,5 +346,7 @@ impl ControllerBody {
             cmd.plan = p;
         }
         ctrl.plans = self.plans;
+        ctrl.pre = self.pre;
+        ctrl.post = self.post;
     }
 }

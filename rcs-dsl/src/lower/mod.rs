@@ -9,6 +9,7 @@
 
 pub(crate) mod consts;
 mod declarations;
+mod every_cycle;
 mod expr;
 mod index;
 mod plans;
@@ -516,6 +517,8 @@ fn lower_controller_headers<'a>(
             subordinates_lists: Vec::new(),
             buffer_spans: Vec::new(),
             buffer_docs: Vec::new(),
+            pre: None,
+            post: None,
         });
     }
     // Where each controller was named as a subordinate, for multiple_supervisors.

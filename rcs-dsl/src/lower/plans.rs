@@ -143,24 +143,21 @@ impl Cx<'_, '_> {
 
     pub(in crate::lower) fn job(&mut self, j: &ast::Job) -> Option<Job> {
         match j {
+            ast::Job::ReportCode(name, code, span) => self.report_code(name, code, *span),
             ast::Job::Report(name, span) => match self.names().statuses.get(&name.text) {
-                Some(i) if i >= 4 => Some(Job::Report {
+                // `report DONE`, `report EXECUTING`, `report ERROR`: the
+                // plan goes on (LANGUAGE.md §7); NOT_READY stays the runtime's.
+                Some(i) if i != StatusId::NOT_READY.index() => Some(Job::Report {
                     status: StatusId(i as u32),
                     span: *span,
+                    error: None,
                 }),
                 Some(_) => {
-                    let target = match name.text.as_str() {
-                        "DONE" => "end the row with `-> Done`",
-                        "ERROR" => "end the row with `-> Error(CODE)`",
-                        _ => "the runtime sets it; report a custom status instead",
-                    };
+                    let target = "the runtime sets it; report `EXECUTING`, `DONE`, `ERROR(CODE)` or a custom status instead";
                     self.diags.push(
                         Diagnostic::error(
                             Code::UnknownName,
-                            format!(
-                                "`report` takes a custom status, and `{}` is built in",
-                                name.text
-                            ),
+                            format!("`report {}` is not allowed", name.text),
                             name.span,
                             "built-in status",
                         )

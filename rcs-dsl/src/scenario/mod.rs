@@ -48,6 +48,8 @@ struct SubSetting {
     status: u16,
     echo: Echo,
     silent: bool,
+    /// Status fields the subordinate publishes from this step on, by name.
+    fields: Vec<(String, Value)>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -68,6 +70,8 @@ struct Expect {
     /// `Some(None)`: no error.
     error: Option<Option<u16>>,
     sent: Option<Vec<(CtrlId, CommandId, Vec<Value>)>>,
+    /// `vars:` and `status_fields:` (a status field is a var the
+    /// controller publishes), by var index.
     vars: Vec<(usize, Value)>,
     /// Subset match: only the fields named are compared.
     writes: Vec<(usize, Json)>,

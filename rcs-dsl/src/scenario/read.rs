@@ -56,6 +56,8 @@ struct RawExpect {
     vars: Option<Entries>,
     writes: Option<Entries>,
     hooks_called: Option<Entries>,
+    /// The controller's own status fields, each a whole value.
+    status_fields: Option<Entries>,
 }
 
 /// A YAML mapping of names to values (`reads:`, `hooks:`, `sent:` …), in
@@ -259,6 +261,27 @@ impl Resolver<'_> {
         Ok(out)
     }
 
+    /// `status_fields:` (in `expect:`): the controller's own status fields
+    /// (`status NAME: TYPE`), each a whole value, as they stand after the
+    /// step (what step 5 published).
+    fn status_fields(&self, e: &Option<Entries>) -> Result<Vec<(usize, Value)>, ScenarioError> {
+        let mut out = Vec::new();
+        for (line, name, v) in entries(e) {
+            let (id, f) = self
+                .c
+                .status_fields()
+                .find(|(_, x)| x.name == *name)
+                .ok_or_else(|| {
+                    err(
+                        line,
+                        format!("`{}` has no status field `{name}`", self.c.name),
+                    )
+                })?;
+            out.push((id.index(), value(self.ir, line, &f.ty, v, name)?));
+        }
+        Ok(out)
+    }
+
     /// `writes:` (in `initial:` and `expect:`): fields of the controller's
     /// own buffers, checked now and merged when used.
     fn writes(&self, e: &Option<Entries>) -> Result<Vec<(usize, Json)>, ScenarioError> {
@@ -375,12 +398,14 @@ impl Resolver<'_> {
                 status: status_of(s)?,
                 echo: Echo::Current,
                 silent: false,
+                fields: Vec::new(),
             }),
             Json::Object(m) => {
                 let mut s = SubSetting {
                     status: 0,
                     echo: Echo::Current,
                     silent: false,
+                    fields: Vec::new(),
                 };
                 for (k, x) in m {
                     match (k.as_str(), x) {
@@ -391,7 +416,12 @@ impl Resolver<'_> {
                             s.echo = Echo::Literal(n.as_u64().and_then(|n| u32::try_from(n).ok()).ok_or_else(|| err(line, "`echo` is a serial (0 to 4294967295)"))?)
                         }
                         ("silent", Json::Bool(b)) => s.silent = *b,
-                        (k, _) => return Err(err(line, format!("bad subordinate setting `{k}`: expected `status: NAME`, `echo: current|previous|N`, `silent: true|false`"))),
+                        (k, x) if sub.status_fields().any(|(_, v)| v.name == k) => {
+                            let (_, f) = sub.status_fields().find(|(_, v)| v.name == k).expect("just found");
+                            let v = value(self.ir, line, &f.ty, x, &format!("{}.{k}", sub.name))?;
+                            s.fields.push((k.to_string(), v));
+                        }
+                        (k, _) => return Err(err(line, format!("bad subordinate setting `{k}`: expected `status: NAME`, `echo: current|previous|N`, `silent: true|false` or a status field of `{}`", sub.name))),
                     }
                 }
                 Ok(s)
@@ -497,6 +527,7 @@ impl Resolver<'_> {
             out.sent = Some(list);
         }
         out.vars = self.vars(&e.vars)?;
+        out.vars.extend(self.status_fields(&e.status_fields)?);
         out.writes = self.writes(&e.writes)?;
         for (line, name, v) in entries(&e.hooks_called) {
             let h = self

@@ -80,6 +80,7 @@ fn drive(
                 status: 0,
                 echo: Echo::Literal(0),
                 silent: false,
+                fields: Vec::new(),
             },
             binding: Binding::Standing,
             shown: 0,
@@ -120,6 +121,10 @@ fn drive(
             }
         }
         for (i, setting) in &step.subs {
+            // Status fields are published once and hold until set again.
+            for (field, v) in &setting.fields {
+                d.write_sub_field(sub_name(*i), field, v).map_err(fail)?;
+            }
             subs[*i].setting = setting.clone();
             subs[*i].binding = if k == 0 {
                 Binding::Standing

@@ -71,6 +71,8 @@ pub(crate) enum Call<'a> {
     SetHook(&'a str, &'a Value),
     WriteSubStatus(&'a str, StatusBuffer),
     LastSent(&'a str),
+    /// A subordinate publishes one of its status fields.
+    WriteSubField(&'a str, &'a str, &'a Value),
 }
 
 impl Call<'_> {
@@ -81,6 +83,7 @@ impl Call<'_> {
             Call::SetHook(hook, v) => d.set_hook(hook, v).map(|()| 0),
             Call::WriteSubStatus(sub, s) => d.write_sub_status(sub, s).map(|()| 0),
             Call::LastSent(sub) => d.last_sent(sub),
+            Call::WriteSubField(sub, field, v) => d.write_sub_field(sub, field, v).map(|()| 0),
         }
     }
 }
@@ -237,6 +240,7 @@ pub(crate) fn run_sequence(
             Some(Bad::Sub(s)) => {
                 p.refused(Call::LastSent(s))?;
                 p.refused(Call::WriteSubStatus(s, StatusBuffer::default()))?;
+                p.refused(Call::WriteSubField(s, "status", &Value::Unit))?;
             }
         }
         for (bi, u) in step.reads.iter().enumerate() {
@@ -274,6 +278,10 @@ pub(crate) fn run_sequence(
                     ..StatusBuffer::default()
                 };
                 p.ok(Call::WriteSubStatus(name, status))?;
+                let sub = ir.controller(*s);
+                for ((_, f), v) in sub.status_fields().zip(&a.fields) {
+                    p.ok(Call::WriteSubField(name, &f.name, v))?;
+                }
             }
         }
         p.cycles(i, step.cycles)?;

@@ -466,8 +466,19 @@ impl Cx<'_, '_> {
             "error" => (SubProp::Error, Type::Bool),
             "stale_cycles" => (SubProp::StaleCycles, Type::Int(IntTy::U32)),
             other => {
-                self.diags.push(Diagnostic::error(Code::UnknownName, format!("subordinate `{}` has no property `{other}`", x.text), field.span, "unknown property")
-                    .with_help("a subordinate offers `status`, `done`, `executing`, `error` and `stale_cycles`"));
+                if let Some(read) = self.sub_field(cid, span, other) {
+                    return read;
+                }
+                let help = self.sub_offers(cid, other);
+                self.diags.push(
+                    Diagnostic::error(
+                        Code::UnknownName,
+                        format!("subordinate `{}` has no property `{other}`", x.text),
+                        field.span,
+                        "unknown property",
+                    )
+                    .with_help(help),
+                );
                 return (err_expr(span), Ty::Err);
             }
         };

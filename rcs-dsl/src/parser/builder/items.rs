@@ -187,6 +187,28 @@ impl Builder {
                 let name = self.name(inner.next()?);
                 EntryKind::Command(name, self.params(inner))
             }
+            Rule::status_field_decl => {
+                let name = self.name(inner.next()?);
+                let ty = self.type_expr(inner.next()?);
+                let init = inner.next().map(|e| self.expr(e));
+                EntryKind::StatusField { name, ty, init }
+            }
+            Rule::every_cycle_decl => {
+                let kw = decl.clone().into_inner().next()?;
+                let phase = if kw.as_rule() == Rule::kw_pre {
+                    Phase::Pre
+                } else {
+                    Phase::Post
+                };
+                let jobs = inner.next()?.into_inner().map(|j| self.job(j)).collect();
+                let target = inner.nth(1).map(|t| self.target(t));
+                EntryKind::EveryCycle(EveryCycleDef {
+                    phase,
+                    keyword: self.span(&kw),
+                    jobs,
+                    target,
+                })
+            }
             Rule::status_decl => EntryKind::Status(inner.map(|n| self.name(n)).collect()),
             Rule::error_decl => EntryKind::Error(inner.map(|n| self.name(n)).collect()),
             Rule::var_decl => {

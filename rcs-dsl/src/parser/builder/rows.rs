@@ -116,8 +116,12 @@ impl Builder {
         let span = self.span(&c);
         match c.as_rule() {
             Rule::report_job => {
-                let n = self.name(c.into_inner().nth(1).expect("status"));
-                Job::Report(n, span)
+                let mut inner = c.into_inner().skip(1);
+                let n = self.name(inner.next().expect("status"));
+                match inner.next() {
+                    Some(code) => Job::ReportCode(n, self.name(code), span),
+                    None => Job::Report(n, span),
+                }
             }
             _ => {
                 let c_text = c.as_str();

@@ -41,6 +41,12 @@ pub(crate) enum Command {
     /// Run scenarios against the plans, on the interpreter or the generated code.
     #[command(after_help = TEST_HELP)]
     Test(TestArgs),
+    /// Write a static, offline site of the plans: graphs, tables, source, findings.
+    #[command(after_help = crate::doc_cmd::DOC_HELP)]
+    Doc(crate::doc_cmd::DocArgs),
+    /// Sum up runtime traces: row hits and cycles per state, as text.
+    #[command(after_help = crate::trace_cmd::TRACE_HELP)]
+    Trace(crate::trace_cmd::TraceArgs),
 }
 
 const TEST_HELP: &str = "\
@@ -77,6 +83,10 @@ pub(crate) struct TestArgs {
     /// After the run, list per plan the rows no scenario fired.
     #[arg(long)]
     pub(crate) coverage: bool,
+    /// Write every cycle of every scenario to FILE as a trace (JSON lines,
+    /// docs/trace-format.md), for `rcsc trace` and `rcsc doc --trace`.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) trace: Option<PathBuf>,
     /// Where the compiled backend builds its driver [default: $CARGO_TARGET_DIR or ./target]
     #[arg(long, value_name = "DIR")]
     pub(crate) target_dir: Option<PathBuf>,

@@ -9,8 +9,10 @@ use std::process::ExitCode;
 mod args;
 mod commands;
 mod compiled;
+mod doc_cmd;
 mod output;
 mod test_cmd;
+mod trace_cmd;
 mod witnesses;
 
 use args::*;
@@ -25,6 +27,8 @@ fn main() -> ExitCode {
         Command::Graph(args) => graph(args),
         Command::Ir(args) => ir(args),
         Command::Test(args) => test_cmd::test(args),
+        Command::Doc(args) => doc_cmd::doc(args),
+        Command::Trace(args) => trace_cmd::trace(args),
     }
 }
 

@@ -6,6 +6,13 @@
 //! `*N` pseudo-node with an edge to its target; edges read `EN: condition`
 //! with the job list in a smaller second line; `otherwise` is dashed; a
 //! `same` edge loops. Nodes and edges appear in the order of the rows.
+//!
+//! Every node and edge carries an `id` that names what it draws, whatever
+//! the layout: `node-<state>` (`node-any-E<N>` for a `*N` pseudo-node),
+//! `edge-E<N>` for row N's edge (its position), `ctrl-<name>` in the
+//! hierarchy. Graphviz copies them into SVG; the doc site keys its links on
+//! them (see [`node_id`], [`edge_id`]), so it does not depend on the rest of
+//! the DOT text.
 
 use crate::GENERATED;
 use rcs_dsl::ir::{Controller, From, Ir, Plan, Target};
@@ -74,7 +81,13 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
     let mut emitted: Vec<String> = Vec::new();
     let mut node = |out: &mut String, id: String, attrs: String| {
         if !emitted.contains(&id) {
-            let _ = writeln!(out, "    {} [{attrs}];", quoted(&id));
+            let sep = if attrs.is_empty() { "" } else { ", " };
+            let _ = writeln!(
+                out,
+                "    {} [id={}{sep}{attrs}];",
+                quoted(&id),
+                quoted(&node_id(&id))
+            );
             emitted.push(id);
         }
     };
@@ -124,7 +137,10 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
                 html(&jobs.join("; "))
             );
         }
-        let mut attrs = format!("label=<{html_label}>");
+        let mut attrs = format!(
+            "id={}, label=<{html_label}>",
+            quoted(&edge_id(&[r.display_name()]))
+        );
         if r.is_otherwise() {
             attrs.push_str(", style=dashed");
         }
@@ -138,6 +154,26 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
     }
     out.push_str("}\n");
     out
+}
+
+/// The `id` of the node named `name` in a plan graph: `node-<state>`, or
+/// `node-any-E<N>` for the `*N` pseudo-node of row N.
+pub fn node_id(name: &str) -> String {
+    match name.strip_prefix('*') {
+        Some(n) => format!("node-any-E{n}"),
+        None => format!("node-{name}"),
+    }
+}
+
+/// The `id` of the edge drawing these rows (named `E<position>`):
+/// `edge-E3`, or `edge-E2-E3-E4` for one edge that stands for several.
+pub fn edge_id(rows: &[String]) -> String {
+    format!("edge-{}", rows.join("-"))
+}
+
+/// The `id` of a controller's node in the hierarchy.
+pub fn ctrl_id(name: &str) -> String {
+    format!("ctrl-{name}")
 }
 
 fn from_node(p: &Printer, r: &rcs_dsl::ir::Row) -> String {
@@ -176,8 +212,9 @@ pub fn hierarchy_graph(ir: &Ir) -> String {
             }
             let _ = writeln!(
                 out,
-                "        {} [label=<{label}>, tooltip={}];",
+                "        {} [id={}, label=<{label}>, tooltip={}];",
                 quoted(&ctrl.name),
+                quoted(&ctrl_id(&ctrl.name)),
                 quoted(&ctrl.docs.join("\n"))
             );
         }

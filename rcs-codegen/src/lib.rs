@@ -20,6 +20,7 @@ pub mod dot;
 pub mod ident;
 pub mod rust;
 pub mod rustfmt;
+pub mod site;
 pub mod table;
 pub mod writer;
 

@@ -3,7 +3,7 @@
 //! state | job list. A pure function returning a string.
 
 use crate::GENERATED;
-use rcs_dsl::ir::{Controller, Ir, Target};
+use rcs_dsl::ir::{Controller, Ir, Row, Target};
 use rcs_dsl::pretty::Printer;
 use std::fmt::Write;
 
@@ -14,6 +14,24 @@ fn cell(s: &str) -> String {
 
 fn code(s: &str) -> String {
     format!("`{}`", cell(s))
+}
+
+/// A row's THEN cell (the next state; `S1 (same)` for `same`) and its jobs
+/// as the language writes them, for every table of rows (here and the doc
+/// site's).
+pub fn next_and_jobs(p: &Printer, r: &Row) -> (String, Vec<String>) {
+    let next = match r.to {
+        Target::Same => format!(
+            "{} (same)",
+            if r.is_dont_care() {
+                "—".to_string()
+            } else {
+                p.from(r)
+            }
+        ),
+        _ => p.target(r),
+    };
+    (next, r.jobs.iter().map(|j| p.job(j)).collect())
 }
 
 /// The state tables of every plan of one controller.
@@ -78,18 +96,8 @@ pub fn controller_tables(ir: &Ir, ctrl: &Controller) -> String {
         out.push_str("| Row | IF (event) | current state | THEN next state | job list |\n");
         out.push_str("|---|---|---|---|---|\n");
         for r in &plan.rows {
-            let next = match r.to {
-                Target::Same => format!(
-                    "{} (same)",
-                    if r.is_dont_care() {
-                        "—".to_string()
-                    } else {
-                        p.from(r)
-                    }
-                ),
-                _ => p.target(r),
-            };
-            let mut jobs: Vec<String> = r.jobs.iter().map(|j| code(&p.job(j))).collect();
+            let (next, jobs) = next_and_jobs(&p, r);
+            let mut jobs: Vec<String> = jobs.iter().map(|j| code(j)).collect();
             match r.to {
                 Target::Done => jobs.push("status DONE".to_string()),
                 Target::Error(_) => jobs.push("status ERROR".to_string()),

@@ -48,7 +48,12 @@ pub(crate) struct DocArgs {
     /// Plan-set folders (using their rcs.yaml) or .rcs files [default: .]
     pub(crate) paths: Vec<PathBuf>,
     /// Where to write the site.
-    #[arg(short = 'o', long = "out-dir", value_name = "DIR", default_value = "target/rcs-doc")]
+    #[arg(
+        short = 'o',
+        long = "out-dir",
+        value_name = "DIR",
+        default_value = "target/rcs-doc"
+    )]
     pub(crate) out_dir: PathBuf,
     /// Open index.html in a browser afterwards.
     #[arg(long)]
@@ -132,7 +137,11 @@ pub(crate) fn doc(args: DocArgs) -> ExitCode {
     };
     status.line(
         "Generating",
-        format!("{} ({} changed)", plural(files.len(), "file"), report.written.len()),
+        format!(
+            "{} ({} changed)",
+            plural(files.len(), "file"),
+            report.written.len()
+        ),
     );
     let index = args.out_dir.join("index.html");
     status.line(
@@ -198,7 +207,8 @@ fn render_all(graphs: &[GraphSource]) -> Result<Option<Svgs>, String> {
 fn render_batch(graphs: &[GraphSource]) -> Result<Vec<String>, String> {
     let input: String = graphs.iter().map(|g| g.dot.as_str()).collect();
     let out = render_svg(&input)?;
-    let text = String::from_utf8(out).map_err(|_| "Graphviz wrote SVG that is not UTF-8".to_string())?;
+    let text =
+        String::from_utf8(out).map_err(|_| "Graphviz wrote SVG that is not UTF-8".to_string())?;
     let mut docs = Vec::with_capacity(graphs.len());
     let mut rest = text.as_str();
     while let Some(end) = rest.find("</svg>") {

@@ -52,10 +52,9 @@ pub(crate) fn counts_from_traces(files: &[PathBuf]) -> Result<RunCounts, String>
     };
     for f in files {
         let shown = rcs_dsl::load::display(f);
-        let text =
-            std::fs::read_to_string(f).map_err(|e| format!("cannot read the trace {shown}: {e}"))?;
-        let records =
-            rcs_runtime::read_trace(&text).map_err(|e| format!("{shown}: {e}"))?;
+        let text = std::fs::read_to_string(f)
+            .map_err(|e| format!("cannot read the trace {shown}: {e}"))?;
+        let records = rcs_runtime::read_trace(&text).map_err(|e| format!("{shown}: {e}"))?;
         for r in records {
             let Some(verb) = r.verb else { continue };
             if let Some(state) = r.state {

@@ -200,7 +200,10 @@ mod tests {
         assert_eq!(e.line, 1);
         assert!(e.message.contains("version 2"), "{e}");
         let other = "{\"format\":\"csv\",\"version\":1}\n";
-        assert!(read_trace(other).unwrap_err().message.contains("not an rcs trace"));
+        assert!(read_trace(other)
+            .unwrap_err()
+            .message
+            .contains("not an rcs trace"));
         let bad = format!("{rec}\nnonsense\n");
         assert_eq!(read_trace(&bad).unwrap_err().line, 2);
     }
@@ -211,7 +214,10 @@ mod tests {
         struct Buf(std::sync::Arc<std::sync::Mutex<Vec<u8>>>);
         impl Write for Buf {
             fn write(&mut self, b: &[u8]) -> io::Result<usize> {
-                self.0.lock().map_err(|_| io::ErrorKind::Other)?.extend_from_slice(b);
+                self.0
+                    .lock()
+                    .map_err(|_| io::ErrorKind::Other)?
+                    .extend_from_slice(b);
                 Ok(b.len())
             }
             fn flush(&mut self) -> io::Result<()> {

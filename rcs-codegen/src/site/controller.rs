@@ -27,12 +27,19 @@ pub(super) fn controller_page(site: &Site, set: &SetDoc, ci: usize, placed: &Pla
         let _ = writeln!(body, "<p class=\"title\">{}</p>", esc(t));
     }
     body.push_str(&docs(&c.docs));
-    let sup = c.supervisor.map(link).unwrap_or_else(|| "the operator".into());
+    let sup = c
+        .supervisor
+        .map(link)
+        .unwrap_or_else(|| "the operator".into());
     let subs: Vec<String> = c.subordinates.iter().map(|s| link(*s)).collect();
     let _ = writeln!(
         body,
         "<p>Commanded by {sup}. Subordinates: {}.</p>",
-        if subs.is_empty() { "none".to_string() } else { subs.join(", ") }
+        if subs.is_empty() {
+            "none".to_string()
+        } else {
+            subs.join(", ")
+        }
     );
     for d in placed.ctrls.get(&ci).into_iter().flatten() {
         body.push_str(&finding(d));
@@ -46,7 +53,10 @@ pub(super) fn controller_page(site: &Site, set: &SetDoc, ci: usize, placed: &Pla
             .map(|p| format!("{}: {}", p.name, rcs_dsl::type_name(ir, &p.ty)))
             .collect();
         let plan = match k.plan {
-            Some(p) => format!("<a href=\"{}\">state graph and table</a>", plan_page(c, &c.plans[p.index()])),
+            Some(p) => format!(
+                "<a href=\"{}\">state graph and table</a>",
+                plan_page(c, &c.plans[p.index()])
+            ),
             None => "—".into(),
         };
         let _ = writeln!(
@@ -73,16 +83,25 @@ pub(super) fn controller_page(site: &Site, set: &SetDoc, ci: usize, placed: &Pla
     };
     body.push_str(&named(
         "Statuses",
-        c.statuses.iter().map(|s| (esc(&s.name), docs(&s.docs))).collect(),
+        c.statuses
+            .iter()
+            .map(|s| (esc(&s.name), docs(&s.docs)))
+            .collect(),
     ));
     body.push_str(&named(
         "Errors",
-        c.errors.iter().map(|e| (esc(&e.name), docs(&e.docs))).collect(),
+        c.errors
+            .iter()
+            .map(|e| (esc(&e.name), docs(&e.docs)))
+            .collect(),
     ));
 
     let buffer = |b: BufferId, how: &str| {
         let buf = &ir.buffers[b.index()];
-        let writer = buf.writer.map(link).unwrap_or_else(|| "an external input".into());
+        let writer = buf
+            .writer
+            .map(link)
+            .unwrap_or_else(|| "an external input".into());
         let readers: Vec<String> = buf.readers.iter().map(|r| link(*r)).collect();
         let about = c
             .buffer_docs
@@ -99,7 +118,11 @@ pub(super) fn controller_page(site: &Site, set: &SetDoc, ci: usize, placed: &Pla
             format!(
                 "{how} · <code>{}</code> · written by {writer} · read by {}{about}",
                 esc(&ir.buffer_types[buf.ty.index()].name),
-                if readers.is_empty() { "no one".to_string() } else { readers.join(", ") }
+                if readers.is_empty() {
+                    "no one".to_string()
+                } else {
+                    readers.join(", ")
+                }
             ),
         )
     };
@@ -113,7 +136,11 @@ pub(super) fn controller_page(site: &Site, set: &SetDoc, ci: usize, placed: &Pla
             .map(|v| {
                 (
                     esc(&v.name),
-                    format!("<code>{}</code>{}", esc(&rcs_dsl::type_name(ir, &v.ty)), docs(&v.docs)),
+                    format!(
+                        "<code>{}</code>{}",
+                        esc(&rcs_dsl::type_name(ir, &v.ty)),
+                        docs(&v.docs)
+                    ),
                 )
             })
             .collect(),
@@ -134,7 +161,12 @@ pub(super) fn controller_page(site: &Site, set: &SetDoc, ci: usize, placed: &Pla
                 };
                 (
                     esc(&h.name),
-                    format!("<code>({}){}</code>{}", esc(&params.join(", ")), esc(&ret), docs(&h.docs)),
+                    format!(
+                        "<code>({}){}</code>{}",
+                        esc(&params.join(", ")),
+                        esc(&ret),
+                        docs(&h.docs)
+                    ),
                 )
             })
             .collect(),

@@ -135,7 +135,11 @@ pub(super) fn search_js(site: &Site) -> String {
         let ir = set.ir;
         let folder = folder(site, set);
         for c in &ir.controllers {
-            entries.push((c.name.clone(), "controller", format!("{folder}{}", ctrl_page(c))));
+            entries.push((
+                c.name.clone(),
+                "controller",
+                format!("{folder}{}", ctrl_page(c)),
+            ));
             for k in &c.commands {
                 let href = match k.plan {
                     Some(p) => format!("{folder}{}", plan_page(c, &c.plans[p.index()])),

@@ -81,7 +81,11 @@ fn ctrl_page(ctrl: &Controller) -> String {
 
 /// The page of a plan, relative to its set's folder.
 fn plan_page(ctrl: &Controller, plan: &Plan) -> String {
-    format!("{}.{}.html", ctrl.name, ctrl.commands[plan.verb.index()].name)
+    format!(
+        "{}.{}.html",
+        ctrl.name,
+        ctrl.commands[plan.verb.index()].name
+    )
 }
 
 /// Every graph of the site, with its links (and run weights) in the DOT.

@@ -27,7 +27,9 @@ pub(super) struct Placed<'a> {
 }
 
 fn inside(outer: Span, inner: Span) -> bool {
-    outer.file == inner.file && outer.start <= inner.start && inner.start < outer.end.max(outer.start + 1)
+    outer.file == inner.file
+        && outer.start <= inner.start
+        && inner.start < outer.end.max(outer.start + 1)
 }
 
 pub(super) fn place_findings<'a>(set: &SetDoc<'a>) -> Placed<'a> {
@@ -58,7 +60,11 @@ pub(super) fn place_findings<'a>(set: &SetDoc<'a>) -> Placed<'a> {
 /// 1-based line of a byte offset.
 pub(super) fn line_of(text: &str, offset: u32) -> usize {
     let end = (offset as usize).min(text.len());
-    text.as_bytes()[..end].iter().filter(|&&b| b == b'\n').count() + 1
+    text.as_bytes()[..end]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
 }
 
 /// The `id`s of the drawn edges and nodes, by row or state name: which
@@ -67,12 +73,12 @@ pub(super) fn line_of(text: &str, offset: u32) -> usize {
 fn drawn(svg: Option<&String>, prefix: &str) -> BTreeMap<String, String> {
     let mut out = BTreeMap::new();
     let Some(svg) = svg else { return out };
-    let needle = format!("id=\"{prefix}");
     let mut rest = svg.as_str();
-    while let Some(at) = rest.find(&needle) {
-        let value = &rest[at + 4..];
+    while let Some(at) = rest.find(" id=\"") {
+        let value = &rest[at + 5..];
         let Some(len) = value.find('"') else { break };
-        let id = &value[..len];
+        // Graphviz writes `-` in ids as `&#45;`.
+        let id = value[..len].replace("&#45;", "-");
         if let Some(names) = id.strip_prefix(prefix) {
             let names: Vec<&str> = if prefix == "edge-" {
                 names.split('-').collect()
@@ -80,7 +86,7 @@ fn drawn(svg: Option<&String>, prefix: &str) -> BTreeMap<String, String> {
                 vec![names]
             };
             for n in names {
-                out.entry(n.to_string()).or_insert_with(|| id.to_string());
+                out.entry(n.to_string()).or_insert_with(|| id.clone());
             }
         }
         rest = &value[len..];
@@ -101,8 +107,16 @@ pub(super) fn plan_page(
     let plan = &ctrl.plans[pi];
     let verb = &ctrl.commands[plan.verb.index()];
     let root = root_of(site);
-    let text = set.sources.get(plan.span.file.0 as usize).copied().unwrap_or("");
-    let file = ir.files.get(plan.span.file.0 as usize).map(String::as_str).unwrap_or("");
+    let text = set
+        .sources
+        .get(plan.span.file.0 as usize)
+        .copied()
+        .unwrap_or("");
+    let file = ir
+        .files
+        .get(plan.span.file.0 as usize)
+        .map(String::as_str)
+        .unwrap_or("");
     let mut body = format!(
         "<nav><a href=\"{root}index.html\">{}</a> › <a href=\"{}\">{}</a> › {}</nav>\n",
         esc(&ir.system),
@@ -122,14 +136,24 @@ pub(super) fn plan_page(
     for d in placed.plans.get(&(ci, pi)).into_iter().flatten() {
         body.push_str(&finding(d));
     }
-    body.push_str(&graph_or_notice(svg, &format!("{}.{}", ctrl.name, verb.name)));
+    body.push_str(&graph_or_notice(
+        svg,
+        &format!("{}.{}", ctrl.name, verb.name),
+    ));
     states(&mut body, ctrl, plan, set, svg, text);
     rows(&mut body, set, ci, pi, svg, placed);
     source(&mut body, plan, text, file);
     page(&format!("{}.{}", ctrl.name, verb.name), root, &body)
 }
 
-fn states(body: &mut String, ctrl: &Controller, plan: &Plan, set: &SetDoc, svg: Option<&String>, text: &str) {
+fn states(
+    body: &mut String,
+    ctrl: &Controller,
+    plan: &Plan,
+    set: &SetDoc,
+    svg: Option<&String>,
+    text: &str,
+) {
     let nodes = drawn(svg, "node-");
     body.push_str("<h2>States</h2>\n<ul class=\"states\">\n");
     let p = Printer::new(set.ir, ctrl, Some(plan));
@@ -150,7 +174,12 @@ fn states(body: &mut String, ctrl: &Controller, plan: &Plan, set: &SetDoc, svg: 
             let _ = write!(body, " <a href=\"#{}\">graph</a>", esc(node));
         }
         if let Some(Some(span)) = plan.states.get(i).map(|s| s.span) {
-            let _ = write!(body, " <a href=\"#L{}\">line {}</a>", line_of(text, span.start), line_of(text, span.start));
+            let _ = write!(
+                body,
+                " <a href=\"#L{}\">line {}</a>",
+                line_of(text, span.start),
+                line_of(text, span.start)
+            );
         }
         if let (Some(r), Some(_)) = (set.runs, plan.states.get(i)) {
             let n = r.state(&ctrl.name, plan.verb.0, i as u32);
@@ -160,7 +189,13 @@ fn states(body: &mut String, ctrl: &Controller, plan: &Plan, set: &SetDoc, svg: 
             .rows
             .iter()
             .filter(|r| p.from(r) == *name)
-            .map(|r| format!("<a href=\"#row-{}\">{}</a>", r.display_name(), esc(&p.label(r))))
+            .map(|r| {
+                format!(
+                    "<a href=\"#row-{}\">{}</a>",
+                    r.display_name(),
+                    esc(&p.label(r))
+                )
+            })
             .collect();
         if !from.is_empty() {
             let _ = write!(body, " — rows: {}", from.join(" "));
@@ -170,7 +205,14 @@ fn states(body: &mut String, ctrl: &Controller, plan: &Plan, set: &SetDoc, svg: 
     body.push_str("</ul>\n");
 }
 
-fn rows(body: &mut String, set: &SetDoc, ci: usize, pi: usize, svg: Option<&String>, placed: &Placed) {
+fn rows(
+    body: &mut String,
+    set: &SetDoc,
+    ci: usize,
+    pi: usize,
+    svg: Option<&String>,
+    placed: &Placed,
+) {
     let ctrl = &set.ir.controllers[ci];
     let plan = &ctrl.plans[pi];
     let p = Printer::new(set.ir, ctrl, Some(plan));
@@ -189,7 +231,10 @@ fn rows(body: &mut String, set: &SetDoc, ci: usize, pi: usize, svg: Option<&Stri
             _ => "",
         };
         let (next, jobs) = next_and_jobs(&p, r);
-        let mut jobs: Vec<String> = jobs.iter().map(|j| format!("<code>{}</code>", esc(j))).collect();
+        let mut jobs: Vec<String> = jobs
+            .iter()
+            .map(|j| format!("<code>{}</code>", esc(j)))
+            .collect();
         match r.to {
             Target::Done => jobs.push("status DONE".into()),
             Target::Error(_) => jobs.push("status ERROR".into()),
@@ -237,14 +282,29 @@ fn source(body: &mut String, plan: &Plan, text: &str, file: &str) {
         .iter()
         .map(|r| (r.line as usize, r.display_name()))
         .collect();
-    let _ = writeln!(body, "<h2>Source</h2>\n<p class=\"file\">{}, lines {first}–{last}</p>\n<pre class=\"source\">", esc(file));
-    for (i, line) in text.lines().enumerate().skip(first - 1).take(last + 1 - first) {
+    let _ = writeln!(
+        body,
+        "<h2>Source</h2>\n<p class=\"file\">{}, lines {first}–{last}</p>\n<pre class=\"source\">",
+        esc(file)
+    );
+    for (i, line) in text
+        .lines()
+        .enumerate()
+        .skip(first - 1)
+        .take(last + 1 - first)
+    {
         let n = i + 1;
         let number = match row_at.get(&n) {
-            Some(row) => format!("<a class=\"ln\" href=\"#row-{row}\" title=\"row {row}\">{n:>4}</a>"),
+            Some(row) => {
+                format!("<a class=\"ln\" href=\"#row-{row}\" title=\"row {row}\">{n:>4}</a>")
+            }
             None => format!("<a class=\"ln\" href=\"#L{n}\">{n:>4}</a>"),
         };
-        let _ = writeln!(body, "<span id=\"L{n}\" class=\"line\">{number} {}</span>", esc(line));
+        let _ = writeln!(
+            body,
+            "<span id=\"L{n}\" class=\"line\">{number} {}</span>",
+            esc(line)
+        );
     }
     body.push_str("</pre>\n");
 }

@@ -30,7 +30,10 @@ impl RunCounts {
     }
 
     pub fn add_state(&mut self, ctrl: &str, verb: u32, state: u32, n: u64) {
-        *self.states.entry((ctrl.to_string(), verb, state)).or_default() += n;
+        *self
+            .states
+            .entry((ctrl.to_string(), verb, state))
+            .or_default() += n;
     }
 
     /// Cycles that fired row `row` of `ctrl`'s verb `verb`.
@@ -122,7 +125,12 @@ impl RunCounts {
     fn plan_summary(&self, c: &Controller, plan: &Plan, out: &mut String) {
         let verb = plan.verb.0;
         let cycles = self.cycles_of(&c.name, verb);
-        if cycles == 0 && !plan.rows.iter().any(|r| self.row(&c.name, verb, r.position) > 0) {
+        if cycles == 0
+            && !plan
+                .rows
+                .iter()
+                .any(|r| self.row(&c.name, verb, r.position) > 0)
+        {
             return;
         }
         let fired = plan

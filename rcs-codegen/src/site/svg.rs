@@ -55,9 +55,7 @@ pub(super) fn link_plan(dot: &str, weights: Option<&BTreeMap<String, u64>>) -> S
             None => format!(", URL=\"#state-{name}\""),
         })
     });
-    let max = weights
-        .and_then(|w| w.values().copied().max())
-        .unwrap_or(0);
+    let max = weights.and_then(|w| w.values().copied().max()).unwrap_or(0);
     insert(&dot, "edge-", |id| {
         let rows: Vec<&str> = id.strip_prefix("edge-")?.split('-').collect();
         let first = rows.first()?;
@@ -68,7 +66,10 @@ pub(super) fn link_plan(dot: &str, weights: Option<&BTreeMap<String, u64>>) -> S
                 attrs.push_str(", class=\"never\"");
             } else {
                 let scale = (((1 + hits) as f64).ln() / ((1 + max.max(1)) as f64).ln()).min(1.0);
-                attrs.push_str(&format!(", class=\"fired\", penwidth={:.2}", 1.0 + 4.0 * scale));
+                attrs.push_str(&format!(
+                    ", class=\"fired\", penwidth={:.2}",
+                    1.0 + 4.0 * scale
+                ));
             }
         }
         Some(attrs)
@@ -100,11 +101,27 @@ mod tests {
     #[test]
     fn ids_get_links_and_quoted_text_is_left_alone() {
         let dot = r#"digraph { "S1" [id="node-S1"]; "*3" [id="node-any-E3", label="x"]; "S1" -> "S1" [id="edge-E2-E4", label=<a>, tooltip="see id=\"edge-E9\""]; }"#;
-        let w: BTreeMap<String, u64> = [("E2".to_string(), 3), ("E4".to_string(), 1), ("E9".to_string(), 0)].into();
+        let w: BTreeMap<String, u64> = [
+            ("E2".to_string(), 3),
+            ("E4".to_string(), 1),
+            ("E9".to_string(), 0),
+        ]
+        .into();
         let out = link_plan(dot, Some(&w));
-        assert!(out.contains(r##"[id="node-S1", URL="#state-S1"]"##), "{out}");
-        assert!(out.contains(r##"[id="node-any-E3", URL="#row-E3", label"##), "{out}");
-        assert!(out.contains(r##"[id="edge-E2-E4", URL="#row-E2", class="fired", penwidth=5.00, label"##), "{out}");
+        assert!(
+            out.contains(r##"[id="node-S1", URL="#state-S1"]"##),
+            "{out}"
+        );
+        assert!(
+            out.contains(r##"[id="node-any-E3", URL="#row-E3", label"##),
+            "{out}"
+        );
+        assert!(
+            out.contains(
+                r##"[id="edge-E2-E4", URL="#row-E2", class="fired", penwidth=5.00, label"##
+            ),
+            "{out}"
+        );
         assert!(out.contains(r#"tooltip="see id=\"edge-E9\"""#), "{out}");
         let h = link_hierarchy(r#""PR" [id="ctrl-PR", label=<PR>];"#, "sub/");
         assert_eq!(h, r#""PR" [id="ctrl-PR", URL="sub/PR.html", label=<PR>];"#);
@@ -114,6 +131,9 @@ mod tests {
 
     #[test]
     fn the_prologue_is_dropped() {
-        assert_eq!(inline("<?xml?>\n<!DOCTYPE svg>\n<svg a>\n</svg>\n"), "<svg a>\n</svg>");
+        assert_eq!(
+            inline("<?xml?>\n<!DOCTYPE svg>\n<svg a>\n</svg>\n"),
+            "<svg a>\n</svg>"
+        );
     }
 }

@@ -260,15 +260,8 @@ async fn the_site_in_chromium() {
     // Every page: a screenshot, and no console error.
     for path in files.keys().filter(|p| p.ends_with(".html")) {
         c.goto(&file_url(&site.join(path))).await.unwrap();
-        screenshot(
-            &c,
-            &shots,
-            &path
-                .replace('/', "__")
-                .trim_end_matches(".html")
-                .to_string(),
-        )
-        .await;
+        let name = path.replace('/', "__");
+        screenshot(&c, &shots, name.trim_end_matches(".html")).await;
         errors.extend(
             console_errors(&c)
                 .await

@@ -21,6 +21,12 @@ use std::fmt::Write;
 
 /// Escape text for a Graphviz HTML-like label.
 fn html(s: &str) -> String {
+    markup(s, "<BR/>")
+}
+
+/// Escape text for HTML or XML (content and double-quoted attributes),
+/// each line break written as `newline`.
+pub(crate) fn markup(s: &str, newline: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
         match c {
@@ -28,7 +34,7 @@ fn html(s: &str) -> String {
             '<' => out.push_str("&lt;"),
             '>' => out.push_str("&gt;"),
             '"' => out.push_str("&quot;"),
-            '\n' => out.push_str("<BR/>"),
+            '\n' => out.push_str(newline),
             c => out.push(c),
         }
     }

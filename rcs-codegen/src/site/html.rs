@@ -5,20 +5,9 @@ use crate::GENERATED;
 use rcs_dsl::Diagnostic;
 use std::fmt::Write;
 
-/// Escape text for HTML content and attribute values.
+/// Escape text for HTML content and (double-quoted) attribute values.
 pub(super) fn esc(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            c => out.push(c),
-        }
-    }
-    out
+    crate::dot::markup(s, "\n")
 }
 
 /// A whole page: `root` leads back to the site's root (`""` or `../`).

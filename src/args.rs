@@ -44,6 +44,12 @@ pub(crate) enum Command {
     /// Compare two versions of plan sets (paths or git revisions), by meaning.
     #[command(after_help = DIFF_HELP)]
     Diff(DiffArgs),
+    /// Write a static, offline site of the plans: graphs, tables, source, findings.
+    #[command(after_help = crate::doc_cmd::DOC_HELP)]
+    Doc(crate::doc_cmd::DocArgs),
+    /// Sum up runtime traces: row hits and cycles per state, as text.
+    #[command(after_help = crate::trace_cmd::TRACE_HELP)]
+    Trace(crate::trace_cmd::TraceArgs),
 }
 
 const DIFF_HELP: &str = "\
@@ -127,6 +133,10 @@ pub(crate) struct TestArgs {
     /// After the run, list per plan the rows no scenario fired.
     #[arg(long)]
     pub(crate) coverage: bool,
+    /// Write every cycle of every scenario to FILE as a trace (JSON lines,
+    /// docs/trace-format.md), for `rcsc trace` and `rcsc doc --trace`.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) trace: Option<PathBuf>,
     /// Where the compiled backend builds its driver [default: $CARGO_TARGET_DIR or ./target]
     #[arg(long, value_name = "DIR")]
     pub(crate) target_dir: Option<PathBuf>,

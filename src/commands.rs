@@ -47,7 +47,22 @@ pub(crate) fn check_sets(
     common: &Common,
     stdout_busy: bool,
     status: Option<&Status>,
-    mut witnesses: Option<&mut witnesses::Witnesses>,
+    witnesses: Option<&mut witnesses::Witnesses>,
+) -> Result<Vec<rcs_dsl::ir::Ir>, ExitCode> {
+    match witnesses {
+        Some(w) => check_sets_each(sets, common, stdout_busy, status, &mut |c| w.collect(c)),
+        None => check_sets_each(sets, common, stdout_busy, status, &mut |_| {}),
+    }
+}
+
+/// [`check_sets`], showing each set's check result to `each` (in the
+/// order of the sets) after its diagnostics are printed.
+pub(crate) fn check_sets_each(
+    sets: &[rcs_dsl::PlanSet],
+    common: &Common,
+    stdout_busy: bool,
+    status: Option<&Status>,
+    each: &mut dyn FnMut(&rcs_dsl::Checked),
 ) -> Result<Vec<rcs_dsl::ir::Ir>, ExitCode> {
     let options = common.options();
     let mut counts = Counts::default();
@@ -65,9 +80,7 @@ pub(crate) fn check_sets(
         }
         let checked = rcs_dsl::check(set, &options);
         print_diagnostics(set, &checked, common, stdout_busy, &mut counts);
-        if let Some(w) = witnesses.as_deref_mut() {
-            w.collect(&checked);
-        }
+        each(&checked);
         irs.extend(checked.ir);
     }
     print_summary(common, &counts);

@@ -10,8 +10,10 @@ mod args;
 mod commands;
 mod compiled;
 mod diff_cmd;
+mod doc_cmd;
 mod output;
 mod test_cmd;
+mod trace_cmd;
 mod witnesses;
 
 use args::*;
@@ -27,6 +29,8 @@ fn main() -> ExitCode {
         Command::Ir(args) => ir(args),
         Command::Test(args) => test_cmd::test(args),
         Command::Diff(args) => diff_cmd::diff(args),
+        Command::Doc(args) => doc_cmd::doc(args),
+        Command::Trace(args) => trace_cmd::trace(args),
     }
 }
 

@@ -7,11 +7,12 @@ use crate::args::*;
 use crate::commands::check_sets;
 use crate::output::*;
 use crate::{compiled, Status};
-use rcs_dsl::ir::{CommandId, Ir, RowId};
+use rcs_codegen::site::RunCounts;
+use rcs_dsl::ir::Ir;
 use rcs_dsl::scenario::{self, Outcome, Scenario};
 use rcs_dsl::source::SourceFile;
 use rcs_dsl::PlanSet;
-use std::collections::BTreeSet;
+use rcs_runtime::{TraceRecord, TraceSink};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -261,16 +262,19 @@ fn failure_report(path: &str, o: &Outcome) -> Option<String> {
     Some(text)
 }
 
-/// Rows fired per (controller, verb, row) over a plan set's scenarios.
-pub type Fired = BTreeSet<(u32, CommandId, RowId)>;
+/// Rows fired and cycles per state over a plan set's scenarios: what
+/// `--coverage` reports and `rcsc doc --coverage` draws.
+pub type Fired = RunCounts;
 
 /// Run the loaded scenarios of one plan set. `remote`: the compiled
-/// backend's driver and this set's number in it.
+/// backend's driver and this set's number in it. Each scenario's hits go
+/// into `fired`, and with `trace`, its cycles into the trace.
 pub fn run_set(
     ir: &Ir,
     loaded: &[Loaded],
     mut remote: Option<(&mut compiled::Driver, usize)>,
     fired: &mut Fired,
+    mut trace: Option<&mut TraceSink>,
 ) -> Result<Vec<ScenarioResult>, String> {
     let mut results = Vec::new();
     for l in loaded {
@@ -289,12 +293,33 @@ pub fn run_set(
             }
             Ok(s) => s,
         };
+        let name = &ir.controller(s.controller).name;
+        let executive = format!("scenario {}", s.name);
+        let mut on_cycle = |rec: &rcs_runtime::driver::Record, new_command: bool| {
+            if let Some(t) = trace.as_deref_mut() {
+                t.write(&TraceRecord {
+                    executive: executive.as_str(),
+                    cycle: rec.cycle,
+                    controller: name.as_str(),
+                    verb: rec.verb,
+                    state: rec.verb.map(|_| rec.state),
+                    status: Some(rec.status.0),
+                    error: Some(rec.error.0),
+                    fired: rec.fired,
+                    new_command,
+                });
+            }
+        };
         let outcome = match remote.as_mut() {
-            None => scenario::run(ir, s),
+            None => scenario::run_observed(
+                ir,
+                s,
+                &mut rcs_dsl::interp::Driven::new(ir, s.controller),
+                &mut on_cycle,
+            ),
             Some((driver, set)) => {
-                let name = &ir.controller(s.controller).name;
                 let mut r = driver.open(*set, name)?;
-                let outcome = scenario::run_on(ir, s, &mut r);
+                let outcome = scenario::run_observed(ir, s, &mut r, &mut on_cycle);
                 if let Some(reason) = r.failure() {
                     return Err(format!("the scenario driver failed: {reason}"));
                 }
@@ -302,8 +327,11 @@ pub fn run_set(
                 outcome
             }
         };
-        for (verb, row) in &outcome.rows {
-            fired.insert((s.controller.0, *verb, *row));
+        for ((verb, row), n) in &outcome.hits {
+            fired.add_row(name, verb.0, row.0, *n);
+        }
+        for ((verb, state), n) in &outcome.states {
+            fired.add_state(name, verb.0, state.0, *n);
         }
         results.push(ScenarioResult {
             path: l.path.clone(),
@@ -317,7 +345,7 @@ pub fn run_set(
 pub fn coverage(set: &PlanSet, ir: &Ir, fired: &Fired) -> (String, usize, usize) {
     let mut text = String::new();
     let (mut hit, mut all) = (0, 0);
-    for (ci, c) in ir.controllers.iter().enumerate() {
+    for c in &ir.controllers {
         for (vi, k) in c.commands.iter().enumerate() {
             let Some(pid) = k.plan else { continue };
             let plan = &c.plans[pid.index()];
@@ -328,11 +356,7 @@ pub fn coverage(set: &PlanSet, ir: &Ir, fired: &Fired) -> (String, usize, usize)
             let missing: Vec<_> = plan
                 .rows
                 .iter()
-                .enumerate()
-                .filter(|(ri, _)| {
-                    !fired.contains(&(ci as u32, CommandId(vi as u32), RowId(*ri as u32)))
-                })
-                .map(|(_, r)| r)
+                .filter(|r| fired.row(&c.name, vi as u32, r.position) == 0)
                 .collect();
             let n = plan.rows.len();
             hit += n - missing.len();
@@ -355,6 +379,28 @@ pub fn coverage(set: &PlanSet, ir: &Ir, fired: &Fired) -> (String, usize, usize)
         }
     }
     (text, hit, all)
+}
+
+/// Row hits and cycles per state of each plan set's own scenarios (its
+/// `scenarios/` folder), run on the interpreter: what `rcsc doc
+/// --coverage` draws. A scenario that fails still counts what it ran.
+pub fn scenario_counts(sets: &[PlanSet], irs: &[Ir]) -> Result<Vec<RunCounts>, String> {
+    let per_set = assign(sets, &[])?;
+    let mut out = Vec::new();
+    for ((ir, files), set) in irs.iter().zip(&per_set).zip(sets) {
+        let loaded: Vec<_> = files.iter().map(|p| load(ir, p)).collect();
+        let mut fired = Fired {
+            source: format!(
+                "{} of {}",
+                crate::output::plural(loaded.len(), "scenario"),
+                rcs_dsl::load::display(&set_folder(set).join("scenarios"))
+            ),
+            ..Fired::default()
+        };
+        run_set(ir, &loaded, None, &mut fired, None)?;
+        out.push(fired);
+    }
+    Ok(out)
 }
 
 /// Print a status line through the CLI's `Status`.
@@ -427,6 +473,18 @@ pub(crate) fn test(args: TestArgs) -> ExitCode {
         }
     }
 
+    let mut trace = match &args.trace {
+        None => None,
+        Some(path) => match std::fs::File::create(path) {
+            Ok(f) => Some(TraceSink::new(std::io::BufWriter::new(f))),
+            Err(e) => {
+                return fail(format!(
+                    "cannot write the trace {}: {e}",
+                    rcs_dsl::load::display(path)
+                ))
+            }
+        },
+    };
     let (mut passed, mut failed) = (0, 0);
     let mut reports = Vec::new();
     let mut coverage_text = String::new();
@@ -442,9 +500,9 @@ pub(crate) fn test(args: TestArgs) -> ExitCode {
                 args.backend.describe()
             ),
         );
-        let mut fired = Fired::new();
+        let mut fired = Fired::default();
         let remote = driver.as_mut().map(|d| (d, i));
-        let results = match run_set(ir, &loaded, remote, &mut fired) {
+        let results = match run_set(ir, &loaded, remote, &mut fired, trace.as_mut()) {
             Ok(r) => r,
             Err(reason) => return fail(reason),
         };
@@ -466,6 +524,11 @@ pub(crate) fn test(args: TestArgs) -> ExitCode {
             coverage_text.push_str(&format!("\ncoverage of {}:\n{text}", ir.system));
             hit += h;
             all += a;
+        }
+    }
+    if let Some(mut t) = trace {
+        if t.flush().is_err() || t.errors() > 0 {
+            return fail("the trace could not be written whole (a write failed)");
         }
     }
     if !reports.is_empty() {

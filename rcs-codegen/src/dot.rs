@@ -14,6 +14,13 @@
 //! what happens in any state when no row matches (an edge from the note
 //! when it leaves the state). Nodes appear in the order of the rows.
 //!
+//! Every node and edge carries an `id`, first among its attributes, that
+//! names what it draws whatever the layout: `node-<state>`
+//! (`node-any-E<N>` for a `*N` pseudo-node or the `otherwise` note),
+//! `edge-E<N>` for row N's edge, `edge-E2-E3-E4` for one edge standing for
+//! several rows, `ctrl-<name>` in the hierarchy. Graphviz copies them into
+//! SVG; the doc site keys its links on them (see [`node_id`], [`edge_id`]).
+//!
 //! [`Edge`] and [`edge_attrs`] are shared with the diff graphs
 //! (`crate::diff_dot`), which colour each line by what a change did to it.
 
@@ -24,6 +31,12 @@ use std::fmt::Write;
 
 /// Escape text for a Graphviz HTML-like label.
 pub(crate) fn html(s: &str) -> String {
+    markup(s, "<BR/>")
+}
+
+/// Escape text for HTML or XML (content and double-quoted attributes),
+/// each line break written as `newline`.
+pub(crate) fn markup(s: &str, newline: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
         match c {
@@ -31,7 +44,7 @@ pub(crate) fn html(s: &str) -> String {
             '<' => out.push_str("&lt;"),
             '>' => out.push_str("&gt;"),
             '"' => out.push_str("&quot;"),
-            '\n' => out.push_str("<BR/>"),
+            '\n' => out.push_str(newline),
             c => out.push(c),
         }
     }
@@ -61,6 +74,8 @@ pub(crate) fn header(out: &mut String, source: &str) {
 /// One row as a line of an edge label.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Line {
+    /// The row's name (`E2`), for the edge's `id`; empty for none.
+    pub(crate) row: String,
     /// `E2: TB.done && x > 1`.
     pub(crate) text: String,
     /// The job list, `;`-separated; empty for none.
@@ -125,7 +140,13 @@ fn edge_attrs(edge: &Edge, all: &[Edge]) -> String {
         }
     }
     let tips: Vec<&str> = edge.lines.iter().map(|l| l.tooltip.as_str()).collect();
-    let mut attrs = format!("label=<{label}>, tooltip={}", quoted(&tips.join("\n")));
+    let rows: Vec<String> = edge.lines.iter().map(|l| l.row.clone()).collect();
+    let id = if rows.iter().any(String::is_empty) {
+        String::new()
+    } else {
+        format!("id={}, ", quoted(&edge_id(&rows)))
+    };
+    let mut attrs = format!("{id}label=<{label}>, tooltip={}", quoted(&tips.join("\n")));
     let fan_in = all
         .iter()
         .filter(|e| e.to == edge.to && e.from != e.to)
@@ -162,6 +183,7 @@ pub(crate) fn row_line(ir: &Ir, p: &Printer, r: &Row) -> Line {
     }
     let jobs: Vec<String> = r.jobs.iter().map(|j| p.job(j)).collect();
     Line {
+        row: r.display_name(),
         text,
         jobs: jobs.join("; "),
         tooltip: tooltip(ir, r),
@@ -241,7 +263,14 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
     let mut emitted: Vec<String> = Vec::new();
     let mut node = |out: &mut String, id: String| {
         if !emitted.contains(&id) {
-            let _ = writeln!(out, "    {} [{}];", quoted(&id), node_attrs(&id));
+            let attrs = node_attrs(&id);
+            let sep = if attrs.is_empty() { "" } else { ", " };
+            let _ = writeln!(
+                out,
+                "    {} [id={}{sep}{attrs}];",
+                quoted(&id),
+                quoted(&node_id(&id))
+            );
             emitted.push(id);
         }
     };
@@ -251,8 +280,9 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
             let note = otherwise_name(r);
             let _ = writeln!(
                 out,
-                "    {} [label=<{}>, shape=note, style=dashed, tooltip={}];",
+                "    {} [id={}, label=<{}>, shape=note, style=dashed, tooltip={}];",
                 quoted(&note),
+                quoted(&node_id(&format!("*{}", r.position))),
                 otherwise_label(&p, r),
                 quoted(&tooltip(ir, r))
             );
@@ -260,9 +290,10 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
                 node(&mut out, to_node(&p, r));
                 let _ = writeln!(
                     out,
-                    "    {} -> {} [style=dashed];",
+                    "    {} -> {} [id={}, style=dashed];",
                     quoted(&note),
-                    quoted(&to_node(&p, r))
+                    quoted(&to_node(&p, r)),
+                    quoted(&edge_id(&[r.display_name()]))
                 );
             }
             continue;
@@ -297,6 +328,26 @@ pub(crate) fn write_edge(out: &mut String, e: &Edge, all: &[Edge], extra: &str) 
         quoted(&e.to),
         edge_attrs(e, all)
     );
+}
+
+/// The `id` of the node named `name` in a plan graph: `node-<state>`, or
+/// `node-any-E<N>` for the `*N` pseudo-node of row N.
+pub fn node_id(name: &str) -> String {
+    match name.strip_prefix('*') {
+        Some(n) => format!("node-any-E{n}"),
+        None => format!("node-{name}"),
+    }
+}
+
+/// The `id` of the edge drawing these rows (named `E<position>`):
+/// `edge-E3`, or `edge-E2-E3-E4` for one edge that stands for several.
+pub fn edge_id(rows: &[String]) -> String {
+    format!("edge-{}", rows.join("-"))
+}
+
+/// The `id` of a controller's node in the hierarchy.
+pub fn ctrl_id(name: &str) -> String {
+    format!("ctrl-{name}")
 }
 
 /// `digraph NAME {` and the graph, node and edge defaults.
@@ -340,8 +391,9 @@ pub fn hierarchy_graph(ir: &Ir) -> String {
             }
             let _ = writeln!(
                 out,
-                "        {} [label=<{label}>, tooltip={}];",
+                "        {} [id={}, label=<{label}>, tooltip={}];",
                 quoted(&ctrl.name),
+                quoted(&ctrl_id(&ctrl.name)),
                 quoted(&ctrl.docs.join("\n"))
             );
         }

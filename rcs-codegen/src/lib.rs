@@ -25,6 +25,7 @@ mod every_cycle;
 pub mod ident;
 pub mod rust;
 pub mod rustfmt;
+pub mod site;
 pub mod table;
 pub mod writer;
 

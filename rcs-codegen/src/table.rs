@@ -6,7 +6,7 @@
 //! function returning a string.
 
 use crate::GENERATED;
-use rcs_dsl::ir::{Controller, Ir, Target};
+use rcs_dsl::ir::{Controller, Ir, Row, Target};
 use rcs_dsl::pretty::Printer;
 use std::fmt::Write;
 
@@ -17,6 +17,19 @@ fn cell(s: &str) -> String {
 
 fn code(s: &str) -> String {
     format!("`{}`", cell(s))
+}
+
+/// A row's THEN cell (the next state; `S1 (same)` for `same`) and its jobs
+/// as the language writes them, for every table of rows (here and the doc
+/// site's).
+pub fn next_and_jobs(p: &Printer, r: &Row) -> (String, Vec<String>) {
+    let next = match r.to {
+        // A don't-care row (or `otherwise`) that stays stays wherever it fired.
+        Target::Same if r.is_dont_care() => "same".to_string(),
+        Target::Same => format!("{} (same)", p.from(r)),
+        _ => p.target(r),
+    };
+    (next, r.jobs.iter().map(|j| p.job(j)).collect())
 }
 
 /// The state tables of every plan of one controller.
@@ -96,17 +109,13 @@ pub fn controller_tables(ir: &Ir, ctrl: &Controller) -> String {
             } else {
                 p.from(r)
             };
-            let next = match r.to {
-                Target::Same if r.is_dont_care() => "same".to_string(),
-                Target::Same => format!("{from} (same)"),
-                _ => p.target(r),
-            };
+            let (next, jobs) = next_and_jobs(&p, r);
             let row = if r.is_otherwise() {
                 crate::dot::otherwise_name(r)
             } else {
                 p.label(r)
             };
-            let mut jobs: Vec<String> = r.jobs.iter().map(|j| code(&p.job(j))).collect();
+            let mut jobs: Vec<String> = jobs.iter().map(|j| code(j)).collect();
             match r.to {
                 Target::Done => jobs.push("status DONE".to_string()),
                 Target::Error(_) => jobs.push("status ERROR".to_string()),

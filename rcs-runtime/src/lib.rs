@@ -204,7 +204,7 @@ pub use handshake::{
 };
 pub use operator::{read_status, Operator};
 pub use plan::{Bookkeeping, NewCommand, SampleStats, Target, Tick, VerbStats};
-pub use trace::{read_trace, TraceRecord, TraceSink};
+pub use trace::{read_trace, TraceError, TraceHeader, TraceRecord, TraceSink, TRACE_VERSION};
 
 /// Include the Rust code `rcsc` generated for a plan set from a build script.
 ///

@@ -70,3 +70,6 @@ pub fn tree(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     }
     out
 }
+
+#[allow(dead_code)] // each test binary compiles this module; not all use it
+pub mod site_links;

@@ -18,6 +18,7 @@
 //! cargo run -p submarine-example                 # real time, on the plan set's 30 ms heartbeat
 //! cargo run -p submarine-example -- --fast       # flat out, at most 2,000 cycles
 //! cargo run -p submarine-example -- --fast 500 --speed 12 --every 1
+//! cargo run -p submarine-example -- --fast --trace run.jsonl   # then: rcsc trace run.jsonl
 //! ```
 //!
 //! Exit status: 0 when PR reports `AT_GOAL`, 1 when it does not (cycle limit
@@ -62,7 +63,9 @@ const USAGE: &str = "usage: submarine [--fast [CYCLES]] [--speed KNOTS] [--every
   --fast [CYCLES]   run flat out instead of on the 30 ms heartbeat (at most CYCLES, default 2000)
   --speed KNOTS     the speed to order: SM <- TRANSIT(speed: KNOTS) (default 15)
   --every CYCLES    print a table row every CYCLES cycles (default 2)
-  --hold CYCLES     after AT_GOAL, keep running CYCLES more cycles to show the speed holds (default 0)";
+  --hold CYCLES     after AT_GOAL, keep running CYCLES more cycles to show the speed holds (default 0)
+  --trace FILE      write every controller's cycles to FILE (JSON lines, docs/trace-format.md;
+                    `rcsc trace FILE` sums them up); also the RCSC_TRACE environment variable";
 
 // ---------------------------------------------------------------------------
 // PR's hooks
@@ -239,8 +242,10 @@ fn nanos(d: Duration) -> u64 {
 // ---------------------------------------------------------------------------
 // Main
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 struct Options {
+    /// Where to write the executive's trace, if anywhere.
+    trace: Option<std::path::PathBuf>,
     fast: bool,
     max_cycles: u64,
     speed: f64,
@@ -251,6 +256,7 @@ struct Options {
 impl Options {
     fn parse(args: impl IntoIterator<Item = String>) -> Result<Option<Self>, String> {
         let mut opts = Options {
+            trace: std::env::var_os("RCSC_TRACE").map(Into::into),
             fast: false,
             max_cycles: MAX_CYCLES,
             speed: 15.0,
@@ -284,6 +290,10 @@ impl Options {
                         .filter(|n| *n > 0)
                         .ok_or(format!("--every: `{v}` is not a positive number"))?;
                 }
+                "--trace" => {
+                    let v = args.next().ok_or("--trace needs a file to write")?;
+                    opts.trace = Some(v.into());
+                }
                 "--hold" => {
                     let v = args.next().ok_or("--hold needs a number of cycles")?;
                     opts.hold = v
@@ -309,7 +319,17 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    match run(opts) {
+    let trace = match &opts.trace {
+        None => None,
+        Some(path) => match std::fs::File::create(path) {
+            Ok(f) => Some(rcs_runtime::TraceSink::new(std::io::BufWriter::new(f))),
+            Err(e) => {
+                eprintln!("submarine: cannot write the trace {}: {e}", path.display());
+                return ExitCode::from(2);
+            }
+        },
+    };
+    match run(opts, trace) {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::FAILURE,
         Err(e) => {
@@ -321,7 +341,11 @@ fn main() -> ExitCode {
 
 /// Run until PR reports AT_GOAL (`Ok(true)`), a controller fails or the cycle
 /// limit passes (`Ok(false)`).
-fn run(opts: Options) -> Result<bool, rcs_runtime::SetupError> {
+/// With `trace`, the executive writes every controller's cycles to it.
+fn run(
+    opts: Options,
+    trace: Option<rcs_runtime::TraceSink>,
+) -> Result<bool, rcs_runtime::SetupError> {
     let hooks = Propulsion {
         rpm_per_knot: MODEL_RPM_PER_KNOT,
         dead_band: DEAD_BAND_KN,
@@ -331,6 +355,9 @@ fn run(opts: Options) -> Result<bool, rcs_runtime::SetupError> {
         return Ok(false);
     };
     let dt = period.as_secs_f64();
+    if let (Some(sink), Some(exec)) = (trace, system.executives.first_mut()) {
+        exec.set_trace(sink);
+    }
 
     // The world before the first cycle: a stopped ship, a still turbine.
     let mut plant = Plant::default();
@@ -423,6 +450,11 @@ fn run(opts: Options) -> Result<bool, rcs_runtime::SetupError> {
         );
     }
 
+    if let Some(mut sink) = system.executives[0].take_trace() {
+        if sink.flush().is_err() || sink.errors() > 0 {
+            eprintln!("submarine: the trace could not be written whole");
+        }
+    }
     let exec = &system.executives[0];
     let stats = exec.stats();
     if opts.fast {

@@ -66,7 +66,9 @@ pub fn diff_dot(plan: &PlanDiff, source: &str) -> String {
         if v.target.starts_with("Error(") {
             text.push_str(&format!(" → {}", v.target));
         }
+        // No ids: a row may stand on both sides of a diff under one name.
         let line = Line {
+            row: String::new(),
             text,
             jobs: v.jobs.join("; "),
             tooltip,

@@ -15,12 +15,12 @@ mod run;
 mod values;
 
 pub use read::parse;
-pub use run::{run, run_on};
+pub use run::{run, run_observed, run_on};
 
 use crate::interp::Value;
-use crate::ir::{CommandId, CtrlId, HookId, RowId};
+use crate::ir::{CommandId, CtrlId, HookId, RowId, StateId};
 use serde_json::Value as Json;
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// The most cycles one step may run. A step's cost is constant in memory
 /// (the rows fired are kept run-length encoded), so the bound is about
@@ -122,6 +122,10 @@ pub struct Outcome {
     /// Rows fired as (verb, row), for coverage; a plan's rows under its
     /// first verb ([`Plan::verb`](crate::ir::Plan::verb)).
     pub rows: BTreeSet<(CommandId, RowId)>,
+    /// How many cycles fired each (verb, row): coverage with hit counts.
+    pub hits: BTreeMap<(CommandId, RowId), u64>,
+    /// How many cycles ended in each (verb, state): the time spent there.
+    pub states: BTreeMap<(CommandId, StateId), u64>,
 }
 
 impl Outcome {

@@ -21,7 +21,7 @@ use crate::interp::{self, Value};
 use crate::ir::*;
 use rcs_runtime::driver::{DriveError, Driven, Record};
 use rcs_runtime::{Status, StatusBuffer};
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// Run a scenario on the reference interpreter.
 pub fn run(ir: &Ir, s: &Scenario) -> Outcome {
@@ -31,13 +31,26 @@ pub fn run(ir: &Ir, s: &Scenario) -> Outcome {
 /// Run a scenario on any backend: the interpreter or a generated `Driver`
 /// of the same controller, fresh.
 pub fn run_on(ir: &Ir, s: &Scenario, driven: &mut dyn Driven) -> Outcome {
+    run_observed(ir, s, driven, &mut |_, _| {})
+}
+
+/// [`run_on`], showing each cycle's record to `on_cycle` with whether a new
+/// command arrived in that cycle (how `rcsc test --trace` writes a trace).
+pub fn run_observed(
+    ir: &Ir,
+    s: &Scenario,
+    driven: &mut dyn Driven,
+    on_cycle: &mut dyn FnMut(&Record, bool),
+) -> Outcome {
     let mut out = Outcome {
         name: s.name.clone(),
         failure: None,
         fired: Vec::new(),
         rows: BTreeSet::new(),
+        hits: BTreeMap::new(),
+        states: BTreeMap::new(),
     };
-    if let Err((line, report)) = drive(ir, s, driven, &mut out) {
+    if let Err((line, report)) = drive(ir, s, driven, &mut out, on_cycle) {
         out.failure = Some((line, report));
     }
     out
@@ -66,6 +79,7 @@ fn drive(
     s: &Scenario,
     d: &mut dyn Driven,
     out: &mut Outcome,
+    on_cycle: &mut dyn FnMut(&Record, bool),
 ) -> Result<(), (usize, String)> {
     let c = ir.controller(s.controller);
     let sub_name = |i: usize| ir.controller(c.subordinates[i]).name.as_str();
@@ -149,7 +163,7 @@ fn drive(
             })
             .collect();
         let mut last: Option<Record> = None;
-        for _ in 0..step.cycles {
+        for n in 0..step.cycles {
             for (i, sub) in subs.iter_mut().enumerate() {
                 if sub.setting.silent {
                     continue;
@@ -169,6 +183,7 @@ fn drive(
             }
             let rec = d.cycle();
             note_fired(c, &rec, out);
+            on_cycle(&rec, n == 0 && step.command.is_some());
             for (h, args) in &rec.hook_args {
                 let limit = keep.iter().find(|(k, _)| k == h).map(|(_, n)| *n);
                 let kept = hook_args.iter().filter(|(k, _)| k == h).count();
@@ -209,6 +224,13 @@ fn note_fired(c: &Controller, rec: &Record, out: &mut Outcome) {
         // A plan shared by verbs (`plan A | B`) is covered once, under its
         // first verb, whichever verb fired the row.
         let verb = plan_of(c, rec).map_or(CommandId(u32::from(v)), |p| p.verb);
-        out.rows.insert((verb, RowId(u32::from(r))));
+        let key = (verb, RowId(u32::from(r)));
+        out.rows.insert(key);
+        *out.hits.entry(key).or_default() += 1;
+    }
+    if let Some(v) = rec.verb {
+        let verb = plan_of(c, rec).map_or(CommandId(u32::from(v)), |p| p.verb);
+        let key = (verb, StateId(u32::from(rec.state)));
+        *out.states.entry(key).or_default() += 1;
     }
 }

@@ -1,0 +1,175 @@
+//! A controller's page: who commands it and whom it commands, its
+//! commands (each linked to its plan), statuses, errors, buffers (each with
+//! every reader and writer), vars, hooks, and the findings about it that
+//! are on no plan.
+
+use super::html::{docs, esc, finding, page};
+use super::index::buffer_anchor;
+use super::plan::Placed;
+use super::{ctrl_page, plan_page, root_of, SetDoc, Site};
+use rcs_dsl::ir::{BufferId, CtrlId};
+use std::fmt::Write;
+
+pub(super) fn controller_page(site: &Site, set: &SetDoc, ci: usize, placed: &Placed) -> String {
+    let ir = set.ir;
+    let c = &ir.controllers[ci];
+    let root = root_of(site);
+    let link = |id: CtrlId| {
+        let o = ir.controller(id);
+        format!("<a href=\"{}\">{}</a>", ctrl_page(o), esc(&o.name))
+    };
+    let mut body = format!(
+        "<nav><a href=\"{root}index.html\">{}</a> › {}</nav>\n",
+        esc(&ir.system),
+        esc(&c.name)
+    );
+    if let Some(t) = &c.title {
+        let _ = writeln!(body, "<p class=\"title\">{}</p>", esc(t));
+    }
+    body.push_str(&docs(&c.docs));
+    let sup = c
+        .supervisor
+        .map(link)
+        .unwrap_or_else(|| "the operator".into());
+    let subs: Vec<String> = c.subordinates.iter().map(|s| link(*s)).collect();
+    let _ = writeln!(
+        body,
+        "<p>Commanded by {sup}. Subordinates: {}.</p>",
+        if subs.is_empty() {
+            "none".to_string()
+        } else {
+            subs.join(", ")
+        }
+    );
+    for d in placed.ctrls.get(&ci).into_iter().flatten() {
+        body.push_str(&finding(d));
+    }
+
+    body.push_str("<h2>Commands</h2>\n<table>\n<tr><th>verb</th><th>parameters</th><th>plan</th><th>about</th></tr>\n");
+    for k in &c.commands {
+        let params: Vec<String> = k
+            .params
+            .iter()
+            .map(|p| format!("{}: {}", p.name, rcs_dsl::type_name(ir, &p.ty)))
+            .collect();
+        let plan = match k.plan {
+            Some(p) => format!(
+                "<a href=\"{}\">state graph and table</a>",
+                plan_page(c, &c.plans[p.index()])
+            ),
+            None => "—".into(),
+        };
+        let _ = writeln!(
+            body,
+            "<tr id=\"cmd-{}\"><td><b>{}</b></td><td><code>{}</code></td><td>{plan}</td><td>{}</td></tr>",
+            esc(&k.name),
+            esc(&k.name),
+            esc(&params.join(", ")),
+            docs(&k.docs)
+        );
+    }
+    body.push_str("</table>\n");
+
+    let named = |title: &str, rows: Vec<(String, String)>| -> String {
+        if rows.is_empty() {
+            return String::new();
+        }
+        let mut s = format!("<h2>{title}</h2>\n<table>\n");
+        for (name, about) in rows {
+            let _ = writeln!(s, "<tr><td><b>{name}</b></td><td>{about}</td></tr>");
+        }
+        s.push_str("</table>\n");
+        s
+    };
+    body.push_str(&named(
+        "Statuses",
+        c.statuses
+            .iter()
+            .map(|s| (esc(&s.name), docs(&s.docs)))
+            .collect(),
+    ));
+    body.push_str(&named(
+        "Errors",
+        c.errors
+            .iter()
+            .map(|e| (esc(&e.name), docs(&e.docs)))
+            .collect(),
+    ));
+
+    let buffer = |b: BufferId, how: &str| {
+        let buf = &ir.buffers[b.index()];
+        let writer = buf
+            .writer
+            .map(link)
+            .unwrap_or_else(|| "an external input".into());
+        let readers: Vec<String> = buf.readers.iter().map(|r| link(*r)).collect();
+        let about = c
+            .buffer_docs
+            .iter()
+            .find(|(id, _)| *id == b)
+            .map(|(_, d)| docs(d))
+            .unwrap_or_default();
+        (
+            format!(
+                "<a href=\"{root}index.html#{}\">{}</a>",
+                esc(&buffer_anchor(ir, &buf.name)),
+                esc(&buf.name)
+            ),
+            format!(
+                "{how} · <code>{}</code> · written by {writer} · read by {}{about}",
+                esc(&ir.buffer_types[buf.ty.index()].name),
+                if readers.is_empty() {
+                    "no one".to_string()
+                } else {
+                    readers.join(", ")
+                }
+            ),
+        )
+    };
+    let mut bufs: Vec<(String, String)> = c.reads.iter().map(|b| buffer(*b, "reads")).collect();
+    bufs.extend(c.writes.iter().map(|b| buffer(*b, "writes")));
+    body.push_str(&named("Buffers", bufs));
+    body.push_str(&named(
+        "Vars",
+        c.vars
+            .iter()
+            .map(|v| {
+                (
+                    esc(&v.name),
+                    format!(
+                        "<code>{}</code>{}",
+                        esc(&rcs_dsl::type_name(ir, &v.ty)),
+                        docs(&v.docs)
+                    ),
+                )
+            })
+            .collect(),
+    ));
+    body.push_str(&named(
+        "Hooks",
+        c.hooks
+            .iter()
+            .map(|h| {
+                let params: Vec<String> = h
+                    .params
+                    .iter()
+                    .map(|p| format!("{}: {}", p.name, rcs_dsl::type_name(ir, &p.ty)))
+                    .collect();
+                let ret = match h.ret {
+                    rcs_dsl::ir::Type::Unit => String::new(),
+                    ref t => format!(" -> {}", rcs_dsl::type_name(ir, t)),
+                };
+                (
+                    esc(&h.name),
+                    format!(
+                        "<code>({}){}</code>{}",
+                        esc(&params.join(", ")),
+                        esc(&ret),
+                        docs(&h.docs)
+                    ),
+                )
+            })
+            .collect(),
+    ));
+    page(&c.name, root, &body)
+}

@@ -1,0 +1,161 @@
+//! IR (+ findings, run counts, rendered graphs) → the pages of the doc site
+//! that `rcsc doc` writes: a back end like [`crate::dot`] and
+//! [`crate::table`], pure, returning files for the [`crate::writer`].
+//!
+//! Two passes, because only the CLI runs Graphviz:
+//!
+//! ```text
+//! sets ──graphs()──▶ DOT per graph (links added) ──dot -Tsvg (CLI)──▶ SVG
+//! sets + SVGs ──pages()──▶ index.html, <CTRL>.html, <CTRL>.<VERB>.html,
+//!                           site.css, site.js, search.js
+//! ```
+//!
+//! The pages link by the `id`s [`crate::dot`] gives nodes and edges
+//! (`node-S1`, `edge-E3`, `ctrl-PR`): [`svg`] turns each id into a link
+//! (`URL`) and, with run counts, a line width and a class, before the DOT
+//! is rendered, so the site does not depend on the graphs' layout. A graph
+//! without SVG (Graphviz missing) is replaced by a notice.
+//!
+//! Anchors a page offers: `row-E<N>` (a table row), `state-<S>` (a state),
+//! `L<line>` (a source line), `edge-E<N>` / `node-<S>` (in the SVG).
+
+mod controller;
+mod html;
+mod index;
+mod plan;
+pub mod runs;
+mod svg;
+
+pub use runs::RunCounts;
+
+use crate::OutputFile;
+use rcs_dsl::ir::{Controller, Ir, Plan};
+use rcs_dsl::Diagnostic;
+use std::collections::BTreeMap;
+
+/// One plan set to document.
+pub struct SetDoc<'a> {
+    pub ir: &'a Ir,
+    /// The text of each file, in `FileId` order (parallel to `ir.files`).
+    pub sources: Vec<&'a str>,
+    /// The findings of `rcsc check` (warnings and analysis findings).
+    pub findings: &'a [Diagnostic],
+    /// Row hits and cycles per state, from scenarios or traces.
+    pub runs: Option<&'a RunCounts>,
+}
+
+/// Every plan set of the site; `shared`: each set gets its own
+/// `<system>/` folder (a workspace or several sets), as `rcsc build` does.
+pub struct Site<'a> {
+    pub sets: Vec<SetDoc<'a>>,
+    pub shared: bool,
+}
+
+/// A graph to render: its key (for [`pages`]) and its DOT text.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GraphSource {
+    pub key: String,
+    pub dot: String,
+}
+
+/// Rendered graphs by key; a key without an entry is drawn as a notice.
+pub type Svgs = BTreeMap<String, String>;
+
+/// The folder of a set's pages, `""` or `<system>/`.
+fn folder(site: &Site, set: &SetDoc) -> String {
+    crate::set_folder(set.ir, site.shared)
+}
+
+fn hierarchy_key(folder: &str) -> String {
+    format!("{folder}hierarchy")
+}
+
+fn plan_key(folder: &str, ctrl: &Controller, plan: &Plan) -> String {
+    format!("{folder}{}", plan_page(ctrl, plan))
+}
+
+/// The page of a controller, relative to its set's folder.
+fn ctrl_page(ctrl: &Controller) -> String {
+    format!("{}.html", ctrl.name)
+}
+
+/// The page of a plan, relative to its set's folder.
+fn plan_page(ctrl: &Controller, plan: &Plan) -> String {
+    format!(
+        "{}.{}.html",
+        ctrl.name,
+        ctrl.commands[plan.verb.index()].name
+    )
+}
+
+/// Every graph of the site, with its links (and run weights) in the DOT.
+pub fn graphs(site: &Site) -> Vec<GraphSource> {
+    let mut out = Vec::new();
+    for set in &site.sets {
+        let folder = folder(site, set);
+        out.push(GraphSource {
+            key: hierarchy_key(&folder),
+            dot: svg::link_hierarchy(&crate::dot::hierarchy_graph(set.ir), &folder),
+        });
+        for ctrl in &set.ir.controllers {
+            for plan in &ctrl.plans {
+                let dot = crate::dot::plan_graph(set.ir, ctrl, plan);
+                let weights = set.runs.map(|r| r.row_weights(&ctrl.name, plan));
+                out.push(GraphSource {
+                    key: plan_key(&folder, ctrl, plan),
+                    dot: svg::link_plan(&dot, weights.as_ref()),
+                });
+            }
+        }
+    }
+    out
+}
+
+/// Every page of the site, given the rendered graphs.
+pub fn pages(site: &Site, svgs: &Svgs) -> Vec<OutputFile> {
+    let placed: Vec<plan::Placed> = site.sets.iter().map(plan::place_findings).collect();
+    let mut files = vec![
+        OutputFile {
+            path: "site.css".into(),
+            contents: format!("/* {} */\n{}", crate::GENERATED, include_str!("site.css")),
+        },
+        OutputFile {
+            path: "site.js".into(),
+            contents: format!("// {}\n{}", crate::GENERATED, include_str!("site.js")),
+        },
+        OutputFile {
+            path: "search.js".into(),
+            contents: index::search_js(site),
+        },
+        OutputFile {
+            path: "index.html".into(),
+            contents: index::index_page(site, svgs, &placed),
+        },
+    ];
+    for (set, placed) in site.sets.iter().zip(&placed) {
+        let folder = folder(site, set);
+        for (ci, ctrl) in set.ir.controllers.iter().enumerate() {
+            files.push(OutputFile {
+                path: format!("{folder}{}", ctrl_page(ctrl)),
+                contents: controller::controller_page(site, set, ci, placed),
+            });
+            for (pi, plan) in ctrl.plans.iter().enumerate() {
+                let key = plan_key(&folder, ctrl, plan);
+                files.push(OutputFile {
+                    contents: plan::plan_page(site, set, ci, pi, svgs.get(&key), placed),
+                    path: key,
+                });
+            }
+        }
+    }
+    files
+}
+
+/// `../` from a set's folder back to the site's root.
+fn root_of(site: &Site) -> &'static str {
+    if site.shared {
+        "../"
+    } else {
+        ""
+    }
+}

@@ -1,0 +1,244 @@
+//! `rcsc doc`: check the plan sets, gather what the site shows beside the
+//! plans (the check's findings; with `--coverage` the scenarios' row hits,
+//! with `--trace` the traces'), render every graph with Graphviz, and write
+//! the pages `rcs_codegen::site` makes through the one output writer.
+//!
+//! Without Graphviz the site is still written, each drawing replaced by a
+//! notice saying how to install it, and a warning is printed: the tables,
+//! source and findings are worth having without the pictures.
+
+use crate::args::Common;
+use crate::commands::{check_sets_each, render_svg};
+use crate::output::*;
+use crate::{test_cmd, trace_cmd};
+use rcs_codegen::site::{self, GraphSource, RunCounts, SetDoc, Site, Svgs};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+pub(crate) const DOC_HELP: &str = "\
+Writes a static site that works offline (plain HTML, one stylesheet, one
+small script; no fonts or scripts from elsewhere) into DIR: index.html with
+each plan set's controller hierarchy and buffers, a page per controller
+(commands, statuses, buffers with every reader and writer, vars, hooks,
+subordinates) and a page per plan (its state graph, states, state table
+with the rows' doc comments and the findings of `rcsc check` on the rows
+they concern, and its source). Every edge and node of a graph links to its
+table row, every row to its edge and source line, and back. A search box
+finds controllers, verbs, buffers and states.
+
+The graphs are drawn by Graphviz `dot` (package `graphviz`). Without it the
+site is written with a notice in place of each drawing, and a warning.
+
+--coverage runs each plan set's scenarios (as `rcsc test --coverage`) and
+--trace reads traces (as `rcsc trace`): every row then shows how many
+cycles fired it, edges are drawn heavier the more they fired, rows that
+never fired are marked, and each state shows the cycles spent in it.
+
+The output is the same, byte for byte, for the same plans and inputs.
+Generated files of an earlier run that are no longer produced are removed.
+
+Examples:
+  rcsc doc plans/ -o target/doc --open
+  rcsc doc plans/submarine --coverage
+  rcsc doc plans/submarine --trace run.jsonl";
+
+#[derive(clap::Args)]
+pub(crate) struct DocArgs {
+    /// Plan-set folders (using their rcs.yaml) or .rcs files [default: .]
+    pub(crate) paths: Vec<PathBuf>,
+    /// Where to write the site.
+    #[arg(
+        short = 'o',
+        long = "out-dir",
+        value_name = "DIR",
+        default_value = "target/rcs-doc"
+    )]
+    pub(crate) out_dir: PathBuf,
+    /// Open index.html in a browser afterwards.
+    #[arg(long)]
+    pub(crate) open: bool,
+    /// Show the row hits of each plan set's scenarios.
+    #[arg(long, conflicts_with = "trace")]
+    pub(crate) coverage: bool,
+    /// Show the row hits of these traces (JSON lines).
+    #[arg(long, value_name = "FILE", num_args = 1..)]
+    pub(crate) trace: Vec<PathBuf>,
+    #[command(flatten)]
+    pub(crate) common: Common,
+}
+
+pub(crate) fn doc(args: DocArgs) -> ExitCode {
+    let start = Instant::now();
+    let status = Status {
+        color: args.common.color(),
+        quiet: args.common.quiet,
+    };
+    let sets = match rcs_dsl::load_paths(&default_paths(args.paths)) {
+        Ok(sets) => sets,
+        Err(e) => return fail(e),
+    };
+    let mut findings: Vec<Vec<rcs_dsl::Diagnostic>> = Vec::new();
+    let mut keep = |c: &rcs_dsl::Checked| findings.push(c.diagnostics.clone());
+    let irs = match check_sets_each(&sets, &args.common, false, Some(&status), &mut keep) {
+        Ok(irs) => irs,
+        Err(code) => return code,
+    };
+    let runs: Vec<RunCounts> = if args.coverage {
+        match test_cmd::scenario_counts(&sets, &irs) {
+            Ok(r) => r,
+            Err(reason) => return fail(reason),
+        }
+    } else if !args.trace.is_empty() {
+        match trace_cmd::counts_from_traces(&args.trace) {
+            Ok(r) => vec![r; irs.len()],
+            Err(reason) => return fail(reason),
+        }
+    } else {
+        Vec::new()
+    };
+    let site = Site {
+        shared: rcs_dsl::load::shares_output(&sets),
+        sets: sets
+            .iter()
+            .zip(&irs)
+            .zip(&findings)
+            .enumerate()
+            .map(|(i, ((set, ir), found))| SetDoc {
+                ir,
+                sources: set.sources.files().map(|(_, f)| f.text.as_str()).collect(),
+                findings: found,
+                runs: runs.get(i),
+            })
+            .collect(),
+    };
+    let graphs = site::graphs(&site);
+    status.line("Drawing", plural(graphs.len(), "graph"));
+    let svgs = match render_all(&graphs) {
+        Ok(Some(svgs)) => svgs,
+        Ok(None) => {
+            if !args.common.quiet {
+                eprintln!("warning: Graphviz `dot` not found: the site has no drawings (install the `graphviz` package, e.g. apt-get install graphviz)");
+            }
+            Svgs::new()
+        }
+        Err(reason) => return fail(reason),
+    };
+    let files = site::pages(&site, &svgs);
+    let mut blocked = |dir: &Path| {
+        status.line(
+            "Blocking",
+            format!("waiting for file lock on {}", rcs_dsl::load::display(dir)),
+        )
+    };
+    let report = match rcs_codegen::writer::write_tree(&args.out_dir, &files, &mut blocked) {
+        Ok(r) => r,
+        Err(e) => return fail(e),
+    };
+    status.line(
+        "Generating",
+        format!(
+            "{} ({} changed)",
+            plural(files.len(), "file"),
+            report.written.len()
+        ),
+    );
+    let index = args.out_dir.join("index.html");
+    status.line(
+        "Finished",
+        format!(
+            "in {:.2}s: {}",
+            start.elapsed().as_secs_f64(),
+            rcs_dsl::load::display(&index)
+        ),
+    );
+    if args.open {
+        open(&index);
+    }
+    ExitCode::SUCCESS
+}
+
+/// Whether Graphviz `dot` can be run.
+fn dot_installed() -> bool {
+    std::process::Command::new("dot")
+        .arg("-V")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .status()
+        .is_ok()
+}
+
+/// Every graph as SVG by key, or `None` when Graphviz is missing. The
+/// graphs go to a few `dot` processes at once, many graphs each (one
+/// process per graph costs more than drawing a small graph).
+fn render_all(graphs: &[GraphSource]) -> Result<Option<Svgs>, String> {
+    if graphs.is_empty() {
+        return Ok(Some(Svgs::new()));
+    }
+    if !dot_installed() {
+        return Ok(None);
+    }
+    let workers = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
+        .clamp(1, 8);
+    let per = graphs.len().div_ceil(workers);
+    let results: Vec<Result<Vec<String>, String>> = std::thread::scope(|s| {
+        let handles: Vec<_> = graphs
+            .chunks(per)
+            .map(|chunk| s.spawn(move || render_batch(chunk)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    });
+    let mut svgs = Svgs::new();
+    for (chunk, svg) in graphs.chunks(per).zip(results) {
+        for (g, svg) in chunk.iter().zip(svg?) {
+            svgs.insert(g.key.clone(), svg);
+        }
+    }
+    Ok(Some(svgs))
+}
+
+/// Several graphs through one `dot -Tsvg`: it draws each graph of its
+/// input in turn, one SVG document after another.
+fn render_batch(graphs: &[GraphSource]) -> Result<Vec<String>, String> {
+    let input: String = graphs.iter().map(|g| g.dot.as_str()).collect();
+    let out = render_svg(&input)?;
+    let text =
+        String::from_utf8(out).map_err(|_| "Graphviz wrote SVG that is not UTF-8".to_string())?;
+    let mut docs = Vec::with_capacity(graphs.len());
+    let mut rest = text.as_str();
+    while let Some(end) = rest.find("</svg>") {
+        let end = end + "</svg>".len();
+        docs.push(rest[..end].trim_start().to_string());
+        rest = &rest[end..];
+    }
+    if docs.len() != graphs.len() {
+        return Err(format!(
+            "Graphviz drew {} of {} graphs",
+            docs.len(),
+            graphs.len()
+        ));
+    }
+    Ok(docs)
+}
+
+/// Open a file in the desktop's browser, if there is one.
+fn open(path: &Path) {
+    let opener = if cfg!(target_os = "macos") {
+        "open"
+    } else if cfg!(windows) {
+        "explorer"
+    } else {
+        "xdg-open"
+    };
+    if let Err(e) = std::process::Command::new(opener).arg(path).status() {
+        eprintln!(
+            "warning: cannot open {} with `{opener}`: {e}",
+            rcs_dsl::load::display(path)
+        );
+    }
+}

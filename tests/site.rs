@@ -1,0 +1,311 @@
+//! `rcsc doc`, `rcsc trace` and traces, end to end: the pages of a small
+//! plan set (snapshots of the pure generation), every link of the site
+//! for `plans/` resolving, byte-identical output, the site without
+//! Graphviz, trace versions, and a run of the submarine example replayed
+//! through `rcsc trace`.
+
+mod common;
+
+use common::site_links::broken_links;
+use common::{rcsc, scratch, text, tree};
+use rcs_codegen::site::{self, SetDoc, Site, Svgs};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+const SMALL: &str = "\
+/// Moves and stops.
+controller A {
+    reads pos: Position
+    command GO(speed: f64)
+    status MOVING
+    plan GO {
+        /// Start moving.
+        E0: *0 when new_command -> S1 { report MOVING }
+        E1: S1 when pos.x > 10.0 -> Done
+        E2: S1 when pos.x > 20.0 -> Done
+        E3: *3 when plan_cycles > 99 -> Error
+    }
+}
+buffer Position { x: f64 }
+";
+
+/// A stand-in for Graphviz: an SVG with one element per `id` of the DOT,
+/// each wrapped in the link the DOT asks for (as `dot -Tsvg` does).
+fn fake_svg(dot: &str) -> String {
+    let mut out = String::from("<?xml version=\"1.0\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" xmlns:xlink=\"http://www.w3.org/1999/xlink\">\n");
+    for line in dot.lines() {
+        let Some(at) = line.find("[id=\"") else {
+            continue;
+        };
+        let rest = &line[at + 5..];
+        let id = &rest[..rest.find('"').unwrap()];
+        let url = rest
+            .split_once("URL=\"")
+            .map(|(_, u)| &u[..u.find('"').unwrap()])
+            .unwrap_or("");
+        out.push_str(&format!(
+            "<g id=\"{id}\"><a xlink:href=\"{url}\"><text>{id}</text></a></g>\n"
+        ));
+    }
+    out.push_str("</svg>\n");
+    out
+}
+
+fn small_site_files(with_runs: bool) -> BTreeMap<String, String> {
+    let set = rcs_dsl::PlanSet::from_texts("small", [("small.rcs", SMALL)], None);
+    // The shadowed row is a warning here, so the site has a finding to show.
+    let shadowed = rcs_dsl::lint::Lint::from_name("shadowed_row").unwrap();
+    let options = rcs_dsl::Options {
+        lint_flags: vec![(shadowed, rcs_dsl::lint::Level::Warn)],
+    };
+    let checked = rcs_dsl::check(&set, &options);
+    let ir = checked.ir.expect("the small set checks");
+    let mut runs = site::RunCounts {
+        source: "a test".into(),
+        ..Default::default()
+    };
+    runs.add_row("A", 0, 0, 1);
+    runs.add_row("A", 0, 1, 1);
+    runs.add_state("A", 0, 1, 7);
+    let s = Site {
+        shared: false,
+        sets: vec![SetDoc {
+            ir: &ir,
+            sources: set.sources.files().map(|(_, f)| f.text.as_str()).collect(),
+            findings: &checked.diagnostics,
+            runs: with_runs.then_some(&runs),
+        }],
+    };
+    let svgs: Svgs = site::graphs(&s)
+        .into_iter()
+        .map(|g| (g.key, fake_svg(&g.dot)))
+        .collect();
+    let mut files: BTreeMap<String, String> = site::pages(&s, &svgs)
+        .into_iter()
+        .map(|f| (f.path, f.contents))
+        .collect();
+    for g in site::graphs(&s) {
+        files.insert(format!("{}.dot", g.key), g.dot);
+    }
+    files
+}
+
+#[test]
+fn pages_of_a_small_plan_set() {
+    let files = small_site_files(true);
+    for (path, contents) in &files {
+        if path.ends_with(".css") || path.ends_with("site.js") {
+            continue;
+        }
+        insta::assert_snapshot!(format!("site_small__{}", path.replace('/', "__")), contents);
+    }
+    // A finding sits on the row it concerns: E2 can never fire after E1.
+    let plan = &files["A.GO.html"];
+    let row = &plan[plan.find("<tr id=\"row-E2\"").unwrap()..];
+    let row = &row[..row.find("</tr>").unwrap()];
+    assert!(row.contains("class=\"finding"), "{row}");
+    // Runs: heavier edges, never-fired rows marked, cycles per state.
+    assert!(files["A.GO.html.dot"].contains("class=\"never\""));
+    assert!(
+        plan.contains("<tr id=\"row-E3\" class=\"never\">"),
+        "{plan}"
+    );
+    assert!(plan.contains("7 cycles"));
+    assert_eq!(broken_links(&files), Vec::<String>::new());
+    // Without runs nothing says so.
+    let plain = small_site_files(false);
+    assert!(!plain["A.GO.html"].contains("hits"));
+}
+
+/// The site's files as text.
+fn site_of(dir: &Path) -> BTreeMap<String, String> {
+    tree(dir)
+        .into_iter()
+        .map(|(p, b)| (p, String::from_utf8(b).expect("UTF-8")))
+        .collect()
+}
+
+#[test]
+fn every_link_of_the_plans_site_resolves_and_output_is_the_same_twice() {
+    let dir = scratch("doc-plans", &[]);
+    let (a, b) = (dir.join("a"), dir.join("b"));
+    for out in [&a, &b] {
+        let o = rcsc(&["doc", "plans", "--coverage", "-o", out.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", text(&o.stderr));
+    }
+    let files = site_of(&a);
+    assert!(
+        files.contains_key("submarine/PR.AHEAD.html"),
+        "{:?}",
+        files.keys()
+    );
+    assert_eq!(broken_links(&files), Vec::<String>::new());
+    assert_eq!(tree(&a), tree(&b), "two runs differ");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn without_graphviz_the_site_has_notices_instead_of_drawings() {
+    let dir = scratch("doc-nodot", &[]);
+    let out = dir.join("site");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rcsc"))
+        .args(["doc", "plans/submarine", "-o", out.to_str().unwrap()])
+        .env("PATH", &dir) // an empty folder: no `dot`
+        .env("NO_COLOR", "1")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("Graphviz `dot` not found"),
+        "{}",
+        text(&o.stderr)
+    );
+    let files = site_of(&out);
+    assert!(files["PR.AHEAD.html"].contains("class=\"notice\""));
+    assert!(!files["PR.AHEAD.html"].contains("<svg"));
+    assert_eq!(broken_links(&files), Vec::<String>::new());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn traces_of_another_version_or_format_are_refused_with_their_line() {
+    let dir = scratch(
+        "trace-versions",
+        &[
+            ("v9.jsonl", "{\"format\":\"rcs-trace\",\"version\":9}\n"),
+            (
+                "junk.jsonl",
+                "{\"format\":\"rcs-trace\",\"version\":1}\nhello\n",
+            ),
+        ],
+    );
+    let o = rcsc(&["trace", dir.join("v9.jsonl").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains("line 1: trace format version 9"),
+        "{}",
+        text(&o.stderr)
+    );
+    let o = rcsc(&["trace", dir.join("junk.jsonl").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o.stderr).contains("line 2: not a trace record"),
+        "{}",
+        text(&o.stderr)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Rows by name with their counts, from `rcsc trace` lines `    E2   9`
+/// under the plan's heading.
+fn trace_counts(summary: &str, plan: &str) -> BTreeMap<String, u64> {
+    let mut out = BTreeMap::new();
+    let mut inside = false;
+    for line in summary.lines() {
+        if !line.starts_with(' ') {
+            inside = line.starts_with(&format!("{plan}:"));
+            continue;
+        }
+        let mut words = line.split_whitespace();
+        if let (true, Some(row), Some(n)) = (inside, words.next(), words.next()) {
+            if let Ok(n) = n.parse() {
+                out.insert(row.to_string(), n);
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn scenario_traces_count_what_coverage_reports() {
+    let dir = scratch("test-trace", &[]);
+    let t = dir.join("t.jsonl");
+    let o = rcsc(&[
+        "test",
+        "plans/submarine",
+        "--coverage",
+        "--trace",
+        t.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let coverage = text(&o.stdout);
+    let o = rcsc(&["trace", t.to_str().unwrap(), "--plans", "plans/submarine"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let summary = text(&o.stdout);
+    // The rows the trace never saw fire are the rows coverage lists.
+    for plan in ["PR.AHEAD", "TB.AHEAD", "SM.TRANSIT"] {
+        let counts = trace_counts(&summary, plan);
+        assert!(!counts.is_empty(), "{plan} missing:\n{summary}");
+        for (row, n) in counts {
+            let listed = coverage.lines().any(|l| {
+                l.trim_start().starts_with("not fired:")
+                    && l.split_whitespace().nth(2) == Some(row.as_str())
+                    && coverage_plan_of(&coverage, l) == plan
+            });
+            assert_eq!(
+                n == 0,
+                listed,
+                "{plan} {row}: {n} in the trace\n{summary}\n{coverage}"
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The plan a `not fired:` line of `rcsc test --coverage` belongs to.
+fn coverage_plan_of<'a>(coverage: &'a str, line: &str) -> &'a str {
+    let mut plan = "";
+    for l in coverage.lines() {
+        if l.ends_with(" rows") && l.starts_with("  ") && !l.starts_with("   ") {
+            plan = l.split_whitespace().next().unwrap_or("");
+        }
+        if l == line {
+            return plan;
+        }
+    }
+    plan
+}
+
+#[test]
+fn a_submarine_run_replays_through_rcsc_trace() {
+    let dir = scratch("replay", &[]);
+    let t = dir.join("run.jsonl");
+    let run = std::process::Command::new(env!("CARGO"))
+        .args([
+            "run",
+            "-q",
+            "-p",
+            "submarine-example",
+            "--",
+            "--fast",
+            "--every",
+            "1",
+            "--trace",
+        ])
+        .arg(&t)
+        .output()
+        .unwrap();
+    let printed = text(&run.stdout);
+    assert!(run.status.success(), "{printed}{}", text(&run.stderr));
+    assert!(printed.contains("PR reports AT_GOAL"), "{printed}");
+    // The rows the run printed: the `PR rows` column, `E2×3 E3`.
+    let mut expected: BTreeMap<String, u64> = BTreeMap::new();
+    for line in printed.lines() {
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        if cells.len() < 4 || cells[0].parse::<u64>().is_err() {
+            continue;
+        }
+        for item in cells[3].split_whitespace().filter(|i| *i != "-") {
+            let (row, n) = item.split_once('×').unwrap_or((item, "1"));
+            *expected.entry(row.to_string()).or_default() += n.parse::<u64>().unwrap();
+        }
+    }
+    assert!(expected.len() > 1, "{printed}");
+    let o = rcsc(&["trace", t.to_str().unwrap(), "--plans", "plans/submarine"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let summary = text(&o.stdout);
+    let mut counted = trace_counts(&summary, "PR.AHEAD");
+    counted.retain(|_, n| *n > 0);
+    assert_eq!(counted, expected, "{summary}\n{printed}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -140,6 +140,7 @@ struct SubState {
 
 /// One controller, interpreted.
 pub struct Interpreter<'ir> {
+    ir: &'ir Ir,
     ctrl: &'ir Controller,
     bk: Bookkeeping,
     cycle: u64,
@@ -162,6 +163,7 @@ impl<'ir> Interpreter<'ir> {
     pub fn new(ir: &'ir Ir, ctrl: CtrlId) -> Interpreter<'ir> {
         let c = ir.controller(ctrl);
         let mut me = Interpreter {
+            ir,
             ctrl: c,
             bk: Bookkeeping::new(c.commands.len()),
             cycle: 0,
@@ -274,12 +276,15 @@ impl<'ir> Interpreter<'ir> {
         // 3b. Pre-process, with or without an active plan.
         let mut sent = Vec::new();
         self.every_cycle(self.ctrl.pre.as_ref(), hooks);
-        // 4. Decide.
-        if self.bk.is_active() {
+        // 4. Decide (an index out of range skips the rest of the cycle's jobs).
+        if self.bk.is_active() && !self.bk.index_range_hit() {
             self.decide(hooks, &mut sent);
         }
         // 4b. Post-process, after the row or none.
-        self.every_cycle(self.ctrl.post.as_ref(), hooks);
+        if !self.bk.index_range_hit() {
+            self.every_cycle(self.ctrl.post.as_ref(), hooks);
+        }
+        self.bk.end_index_range();
         // 5. Write (the record), 6. account.
         let record = CycleRecord {
             cycle: self.cycle,
@@ -317,7 +322,13 @@ impl<'ir> Interpreter<'ir> {
                 continue;
             }
             if let Condition::When(c) = &r.cond {
-                if truthy(&self.eval(c, hooks)) {
+                let matched = truthy(&self.eval(c, hooks));
+                if self.bk.index_range_hit() {
+                    // No row fires; the cycle ends the plan with INDEX_RANGE.
+                    self.condition_calls = None;
+                    return;
+                }
+                if matched {
                     chosen = Some(r);
                     break;
                 }
@@ -327,9 +338,7 @@ impl<'ir> Interpreter<'ir> {
         let Some(row) = chosen.or_else(|| plan.otherwise()) else {
             return;
         };
-        for j in &row.jobs {
-            self.job(j, hooks, sent);
-        }
+        self.jobs(&row.jobs, hooks, sent);
         let target = match row.to {
             Target::State(s) => rcs_runtime::Target::State(s.0 as u16),
             Target::Same => rcs_runtime::Target::Same,
@@ -340,13 +349,34 @@ impl<'ir> Interpreter<'ir> {
         self.bk.fire(row.position as u16, target);
     }
 
+    /// Jobs in order, up to an index out of range.
+    pub(super) fn jobs(&mut self, jobs: &[Job], hooks: &mut dyn Hooks, sent: &mut Vec<Sent>) {
+        for j in jobs {
+            if self.bk.index_range_hit() {
+                return;
+            }
+            self.job(j, hooks, sent);
+        }
+    }
+
+    /// One job. An index out of range met while evaluating it leaves the
+    /// job undone (no assignment, no send); a hook called on the way was
+    /// still called.
     fn job(&mut self, j: &Job, hooks: &mut dyn Hooks, sent: &mut Vec<Sent>) {
         match j {
             Job::Assign {
                 place, op, value, ..
             } => {
                 let v = self.eval(value, hooks);
-                let slot = self.place_mut(place);
+                let indices: Vec<Value> =
+                    place.indices.iter().map(|i| self.eval(i, hooks)).collect();
+                if self.bk.index_range_hit() {
+                    return;
+                }
+                let Some(slot) = self.place_mut(place, &indices) else {
+                    self.bk.index_range();
+                    return;
+                };
                 let new = match (op, &place.ty) {
                     (AssignOp::Set, _) => v,
                     (_, Type::Int(t)) => {
@@ -370,13 +400,17 @@ impl<'ir> Interpreter<'ir> {
                     }
                     _ => v,
                 };
-                *self.place_mut(place) = new;
+                if let Some(slot) = self.place_mut(place, &indices) {
+                    *slot = new;
+                }
             }
             Job::Send {
                 sub, command, args, ..
             } => {
                 let args: Vec<Value> = args.iter().map(|a| self.eval(a, hooks)).collect();
-                self.send(*sub, *command, args, sent);
+                if !self.bk.index_range_hit() {
+                    self.send(*sub, *command, args, sent);
+                }
             }
             Job::Report {
                 error: Some(code), ..
@@ -393,7 +427,9 @@ impl<'ir> Interpreter<'ir> {
         }
     }
 
-    fn place_mut(&mut self, p: &Place) -> &mut Value {
+    /// The slot of place `p` whose run-time indices evaluated to `indices`;
+    /// `None` if one is out of range.
+    fn place_mut(&mut self, p: &Place, indices: &[Value]) -> Option<&mut Value> {
         let mut slot = match p.root {
             PlaceRoot::Var(v) => &mut self.vars[v.index()],
             PlaceRoot::Buffer(b) => {
@@ -410,10 +446,13 @@ impl<'ir> Interpreter<'ir> {
             slot = match (proj, slot) {
                 (Projection::Field(f), Value::Buffer(fs)) => &mut fs[*f as usize],
                 (Projection::Index(i), Value::Array(es)) => &mut es[*i as usize],
-                (_, other) => return other,
+                (Projection::IndexBy(k), Value::Array(es)) => {
+                    es.get_mut(element_index(indices.get(*k as usize)?)?)?
+                }
+                (_, other) => return Some(other),
             };
         }
-        slot
+        Some(slot)
     }
 
     /// Evaluate an expression of this controller (left to right, `&&` and
@@ -507,6 +546,20 @@ impl<'ir> Interpreter<'ir> {
                 crate::builtin::apply(*b, &values, ty)
             }
             ExprKind::SubField(c, v) => self.sub_field(*c, *v),
+            ExprKind::IndexBy(base, i) => {
+                let array = self.eval(base, hooks);
+                let i = self.eval(i, hooks);
+                let Value::Array(mut es) = array else {
+                    return array;
+                };
+                match element_index(&i).filter(|i| *i < es.len()) {
+                    Some(i) => es.swap_remove(i),
+                    None => {
+                        self.bk.index_range();
+                        zero(self.ir, &e.ty)
+                    }
+                }
+            }
         }
     }
 
@@ -523,6 +576,15 @@ impl<'ir> Interpreter<'ir> {
         let a = self.eval(l, hooks);
         let b = self.eval(r, hooks);
         crate::arith::binary(op, a, b, ty)
+    }
+}
+
+/// A run-time index as a position, if it is a non-negative integer that
+/// fits `usize` (whether it is inside the array is the caller's check).
+fn element_index(i: &Value) -> Option<usize> {
+    match i {
+        Value::Int(i) => usize::try_from(*i).ok(),
+        _ => None,
     }
 }
 

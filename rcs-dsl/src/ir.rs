@@ -491,13 +491,17 @@ pub enum Job {
 }
 
 /// Something a job may assign to: a var or a `writes` buffer, then fields
-/// and constant indices.
+/// and indices (constant, or run-time values kept in `indices`).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Place {
     pub root: PlaceRoot,
     pub path: Vec<Projection>,
     pub ty: Type,
     pub span: Span,
+    /// The run-time index expressions of the path's
+    /// [`Projection::IndexBy`], in path order (evaluated after the value).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub indices: Vec<Expr>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -514,6 +518,10 @@ pub enum Projection {
     Field(u32),
     /// Constant array index (checked in bounds).
     Index(u32),
+    /// Array index by a run-time value: the `n`-th of [`Place::indices`];
+    /// out of range, the assignment does nothing and the plan ends with
+    /// `INDEX_RANGE`.
+    IndexBy(u32),
 }
 
 /// A typed expression. `ty` is always concrete (literals take the type their
@@ -566,6 +574,9 @@ pub enum ExprKind {
     /// `X.NAME`: status field `NAME` (a var of subordinate X) as X last
     /// published it, whatever serial X echoes (not through the handshake).
     SubField(CtrlId, VarId),
+    /// `a[i]` with a run-time integer `i` (the second expression): out of
+    /// range, the element type's zero, and the plan ends with `INDEX_RANGE`.
+    IndexBy(Box<Expr>, Box<Expr>),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -642,7 +653,7 @@ impl Expr {
             | ExprKind::Index(e, _)
             | ExprKind::Unary(_, e)
             | ExprKind::Cast(e) => e.visit(f),
-            ExprKind::Binary(_, l, r) => {
+            ExprKind::Binary(_, l, r) | ExprKind::IndexBy(l, r) => {
                 l.visit(f);
                 r.visit(f);
             }
@@ -651,6 +662,27 @@ impl Expr {
             }
             _ => {}
         }
+    }
+}
+
+impl Expr {
+    /// Whether evaluating this expression can meet an index out of range
+    /// (it indexes by a run-time value).
+    pub fn indexes_by_value(&self) -> bool {
+        let mut found = false;
+        self.visit(&mut |x| found |= matches!(x.kind, ExprKind::IndexBy(..)));
+        found
+    }
+}
+
+impl Job {
+    /// Whether performing this job can meet an index out of range.
+    pub fn indexes_by_value(&self) -> bool {
+        let mut found = matches!(self, Job::Assign { place, .. } if !place.indices.is_empty());
+        visit_job_exprs(std::slice::from_ref(self), &mut |x| {
+            found |= matches!(x.kind, ExprKind::IndexBy(..))
+        });
+        found
     }
 }
 
@@ -672,11 +704,14 @@ impl EveryCycle {
 }
 
 /// Every expression of `jobs`, in order (assignment targets are places,
-/// not expressions, and are not visited).
+/// not expressions: only their run-time indices are visited, after the value).
 pub fn visit_job_exprs(jobs: &[Job], f: &mut dyn FnMut(&Expr)) {
     for j in jobs {
         match j {
-            Job::Assign { value, .. } => value.visit(f),
+            Job::Assign { value, place, .. } => {
+                value.visit(f);
+                place.indices.iter().for_each(|i| i.visit(f));
+            }
             Job::Send { args, .. } => args.iter().for_each(|a| a.visit(f)),
             Job::Call(e) => e.visit(f),
             Job::Report { .. } | Job::Forward { .. } => {}

@@ -78,6 +78,12 @@ impl<'a> Printer<'a> {
                 self.write(base, ATOM, out);
                 out.push_str(&format!("[{i}]"));
             }
+            ExprKind::IndexBy(base, i) => {
+                self.write(base, ATOM, out);
+                out.push('[');
+                out.push_str(&self.expr(i));
+                out.push(']');
+            }
             ExprKind::Call(_, args) | ExprKind::Builtin(_, args) => {
                 out.push_str(match &e.kind {
                     ExprKind::Call(h, _) => &self.ctrl.hooks[h.index()].name,
@@ -149,6 +155,12 @@ impl<'a> Printer<'a> {
                 }
                 (Projection::Index(i), Type::Array(elem, _)) => {
                     s.push_str(&format!("[{i}]"));
+                    ty = (**elem).clone();
+                }
+                (Projection::IndexBy(k), Type::Array(elem, _)) => {
+                    if let Some(i) = p.indices.get(*k as usize) {
+                        s.push_str(&format!("[{}]", self.expr(i)));
+                    }
                     ty = (**elem).clone();
                 }
                 _ => {}

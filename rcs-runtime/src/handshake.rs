@@ -67,7 +67,8 @@ impl Status {
 }
 
 /// An error code: 0 is "no error", 1 is the runtime's `UNKNOWN_COMMAND`,
-/// error codes declared by a controller follow from 2.
+/// error codes declared by a controller follow from 2; `u16::MAX` is the
+/// runtime's `INDEX_RANGE`.
 #[derive(
     Debug, Clone, Copy, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
 )]
@@ -79,6 +80,11 @@ impl ErrorCode {
     pub const NONE: ErrorCode = ErrorCode(0);
     /// A command verb for which the controller has no plan.
     pub const UNKNOWN_COMMAND: ErrorCode = ErrorCode(1);
+    /// An array indexed by a run-time value outside its bounds: the plan
+    /// ends with this built-in error. The last code, so that the codes of
+    /// declared errors (from [`FIRST_CUSTOM`](Self::FIRST_CUSTOM)) keep
+    /// their numbers.
+    pub const INDEX_RANGE: ErrorCode = ErrorCode(u16::MAX);
     /// The code of the first declared error.
     pub const FIRST_CUSTOM: u16 = 2;
 

@@ -183,6 +183,7 @@ pub mod error;
 pub mod exec;
 pub mod gm;
 pub mod handshake;
+pub mod index;
 pub mod math;
 pub mod operator;
 pub mod plan;

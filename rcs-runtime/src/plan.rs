@@ -140,6 +140,8 @@ pub struct Bookkeeping {
     now: Option<Instant>,
     started_at: Option<Instant>,
     verb_stats: Vec<VerbStats>,
+    /// An index out of range was met this cycle (see [`Bookkeeping::index_range`]).
+    index_range: bool,
 }
 
 impl Bookkeeping {
@@ -160,6 +162,7 @@ impl Bookkeeping {
             now: None,
             started_at: None,
             verb_stats: vec![VerbStats::default(); verb_count],
+            index_range: false,
         }
     }
 
@@ -191,6 +194,7 @@ impl Bookkeeping {
         has_plan: bool,
     ) -> NewCommand {
         self.fired = None;
+        self.index_range = false;
         self.now = Some(tick.now);
         if serial == self.echo_serial {
             self.new_command = false;
@@ -239,6 +243,11 @@ impl Bookkeeping {
             return false;
         }
         self.fired = Some(row);
+        let target = if self.index_range {
+            Target::Error(ErrorCode::INDEX_RANGE)
+        } else {
+            target
+        };
         match target {
             Target::State(s) => {
                 if s != self.state {
@@ -299,6 +308,33 @@ impl Bookkeeping {
     pub fn report_error(&mut self, code: ErrorCode) {
         self.status = Status::ERROR;
         self.error = code;
+    }
+
+    /// An array was indexed outside its bounds this cycle: the rest of the
+    /// cycle's jobs is skipped (the caller's part), a row firing now ends
+    /// the plan with `INDEX_RANGE` instead of its target, and
+    /// [`end_index_range`](Self::end_index_range) ends the plan if no row fires.
+    #[inline]
+    pub fn index_range(&mut self) {
+        self.index_range = true;
+    }
+
+    /// Whether an index was out of range this cycle.
+    #[inline]
+    pub fn index_range_hit(&self) -> bool {
+        self.index_range
+    }
+
+    /// If an index was out of range this cycle: status ERROR, error
+    /// `INDEX_RANGE`, and the active plan (if any) ends. Called after the
+    /// conditions, `pre` and `post` jobs that index by a value.
+    #[inline]
+    pub fn end_index_range(&mut self) {
+        if self.index_range {
+            self.status = Status::ERROR;
+            self.error = ErrorCode::INDEX_RANGE;
+            self.finish(false);
+        }
     }
 
     /// Step 6: count the cycle (`state_cycles` and `plan_cycles` grow by

@@ -404,6 +404,7 @@ pub(crate) fn module(
         post: post_jobs,
         write: status_fields_write,
     } = super::every_cycle::parts(ir, names, ci, comments);
+    let (decide_call, post_call) = super::index::cycle_steps(&ir.controllers[ci], post_jobs);
 
     let verb_count_lit = proc_macro2::Literal::usize_unsuffixed(verb_count);
     // The six steps of a cycle (docs/semantics.md), as comments in the output.
@@ -615,10 +616,8 @@ pub(crate) fn module(
                     }
                     #pre_jobs
                     #step4
-                    if self.bk.is_active() {
-                        self.decide(subs);
-                    }
-                    #post_jobs
+                    #decide_call
+                    #post_call
                     #step5
                     self.status_out.write(self.bk.status_buffer(), ctx.cycle);
                     #status_fields_write

@@ -155,14 +155,14 @@ pub(crate) fn parts(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments) 
     if let Some(b) = &c.pre {
         let step = comments
             .marker("3b. Pre-process: the `pre` jobs, with or without an active plan.".to_string());
-        let jobs = b.jobs.iter().map(|j| gen.job(j));
-        p.pre.extend(quote!(#step #(#jobs)*));
+        let jobs = gen.jobs(&b.jobs);
+        p.pre.extend(quote!(#step #jobs));
     }
     if let Some(b) = &c.post {
         let step = comments
             .marker("4b. Post-process: the `post` jobs, after the row or none.".to_string());
-        let jobs = b.jobs.iter().map(|j| gen.job(j));
-        p.post.extend(quote!(#step #(#jobs)*));
+        let jobs = gen.jobs(&b.jobs);
+        p.post.extend(quote!(#step #jobs));
     }
     p
 }

@@ -9,6 +9,7 @@ mod controller;
 mod driver;
 mod every_cycle;
 mod expr;
+mod index;
 mod names;
 mod plan;
 mod system;

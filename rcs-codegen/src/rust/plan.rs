@@ -120,7 +120,7 @@ pub(super) fn plan_fn(
     // Relative to the plan set's root: outputs never carry absolute paths.
     let file = &ir.files[p.header.file.0 as usize];
 
-    let row_code = |r: &Row, comments: &mut Comments| -> (Option<Code>, TokenStream) {
+    let row_code = |r: &Row, comments: &mut Comments| -> (Option<(Code, bool)>, TokenStream) {
         let text = format!(
             "{}: {} when {} -> {}   [{file}:{}]",
             printer.label(r),
@@ -133,7 +133,7 @@ pub(super) fn plan_fn(
         let doc_markers: Vec<TokenStream> =
             r.docs.iter().map(|l| comments.marker(l.clone())).collect();
         let marker = comments.marker(text);
-        let jobs: Vec<TokenStream> = r.jobs.iter().map(|j| gen.job(j)).collect();
+        let jobs = gen.jobs(&r.jobs);
         let pos = r.position as u16;
         let target = match r.to {
             Target::State(s) => {
@@ -151,11 +151,14 @@ pub(super) fn plan_fn(
         let body = quote! {
             #(#doc_markers)*
             #marker
-            #(#jobs)*
+            #jobs
             self.bk.fire(#pos, #target);
         };
         let cond = match &r.cond {
-            Condition::When(e) => Some(cond_gen.expr(e)),
+            Condition::When(e) if e.indexes_by_value() => {
+                Some((super::index::guarded_condition(cond_gen.expr(e)), true))
+            }
+            Condition::When(e) => Some((cond_gen.expr(e), false)),
             Condition::Otherwise => None,
         };
         (cond, body)
@@ -163,14 +166,31 @@ pub(super) fn plan_fn(
 
     // The rows of one arm as an if / else-if chain, `otherwise` last.
     let chain = |rows: &[&Row], comments: &mut Comments| -> TokenStream {
-        let mut parts: Vec<(Option<Code>, TokenStream)> =
+        let mut parts: Vec<(Option<(Code, bool)>, TokenStream)> =
             rows.iter().map(|r| row_code(r, comments)).collect();
         let otherwise = p.otherwise().map(|r| row_code(r, comments).1);
         // Build from the end: else-branch first. The flag says whether the
         // tail is an `if` expression, which may follow `else` directly.
-        let mut tail: Option<(TokenStream, bool)> = otherwise.map(|t| (t, false));
+        // After a condition that met an index out of range, no later row
+        // (nor `otherwise`) is tried: the cycle ends the plan with INDEX_RANGE.
+        let indexes: Vec<bool> = parts
+            .iter()
+            .map(|(c, _)| c.as_ref().is_some_and(|(_, i)| *i))
+            .collect();
+        let mut tail: Option<(TokenStream, bool)> = otherwise.map(|t| {
+            if indexes.contains(&true) {
+                (quote!(if !self.bk.index_range_hit() { #t }), true)
+            } else {
+                (t, false)
+            }
+        });
         while let Some((cond, body)) = parts.pop() {
-            let cond = cond.expect("only otherwise has no condition");
+            let (cond, _) = cond.expect("only otherwise has no condition");
+            let cond = if indexes[..parts.len()].contains(&true) {
+                super::index::after_index(cond)
+            } else {
+                cond
+            };
             let ts = &cond.ts;
             tail = Some(if cond.has_block {
                 // A hoisted hook call cannot stand in an `if` condition.

@@ -162,13 +162,22 @@ impl<'ir> PlanAnalysis<'ir> {
             tables,
             candidates: std::cell::OnceCell::new(),
             new_command,
-            skipped: plan.rows.len() > MAX_ANALYSED || plan.states.len() > MAX_ANALYSED,
+            // A condition that indexes by a value can end the plan with
+            // INDEX_RANGE instead of matching or not; until the questions
+            // model that outcome, such a plan is left alone like a big one.
+            skipped: plan.rows.len() > MAX_ANALYSED
+                || plan.states.len() > MAX_ANALYSED
+                || plan.rows.iter().any(|r| match &r.cond {
+                    Condition::When(e) => e.indexes_by_value(),
+                    Condition::Otherwise => false,
+                }),
             proved: Default::default(),
         }
     }
 
     /// Whether the analysis answers questions about this plan: plans of
-    /// more than [`MAX_ANALYSED`] rows or states are left alone.
+    /// more than [`MAX_ANALYSED`] rows or states, and plans with a condition
+    /// that indexes by a run-time value, are left alone.
     pub fn analysed(&self) -> bool {
         !self.skipped
     }

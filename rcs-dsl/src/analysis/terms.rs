@@ -184,6 +184,13 @@ impl Terms {
                 *scalar = false;
                 self.collect_leaves(x, out, scalar);
             }
+            ExprKind::IndexBy(x, i) => {
+                // Indexing by a value is opaque (and may end the plan with
+                // INDEX_RANGE): an atom reading one is never exact.
+                *scalar = false;
+                self.collect_leaves(x, out, scalar);
+                self.collect_leaves(i, out, scalar);
+            }
             ExprKind::Unary(_, x) | ExprKind::Cast(x) => self.collect_leaves(x, out, scalar),
             ExprKind::Binary(_, l, r) => {
                 self.collect_leaves(l, out, scalar);
@@ -261,7 +268,7 @@ fn with_step(leaf: Leaf, step: Step) -> Option<Leaf> {
 fn leaf_free(e: &Expr) -> bool {
     let mut free = true;
     e.visit(&mut |x| {
-        if as_leaf(x).is_some() {
+        if as_leaf(x).is_some() || matches!(x.kind, ExprKind::IndexBy(..)) {
             free = false;
         }
     });

@@ -23,9 +23,7 @@ impl Interpreter<'_> {
     pub(super) fn every_cycle(&mut self, block: Option<&EveryCycle>, hooks: &mut dyn Hooks) {
         let Some(block) = block else { return };
         let mut sent = Vec::new();
-        for j in &block.jobs {
-            self.job(j, hooks, &mut sent);
-        }
+        self.jobs(&block.jobs, hooks, &mut sent);
         debug_assert!(sent.is_empty(), "a send in an every-cycle block");
     }
 

@@ -2,7 +2,7 @@
 //! targets), jobs, sends and assignment places, checked through the
 //! expression checker of `lower::expr`.
 
-use super::expr::{Cx, Value};
+use super::expr::{Cx, Subscript, Value};
 use super::*;
 use crate::ast::{self, AssignOp, BinOp};
 use crate::diagnostic::{Code, Diagnostic};
@@ -410,9 +410,9 @@ impl Cx<'_, '_> {
             ast::ExprKind::Path(None, n) => match self.value(&n.text) {
                 Some(Value::Var(v)) => {
                     let ty = self.c.vars[v.index()].ty.clone();
-                    (ty != Type::Unit).then_some(Place { root: PlaceRoot::Var(v), path: Vec::new(), ty, span: e.span })
+                    (ty != Type::Unit).then_some(Place { root: PlaceRoot::Var(v), path: Vec::new(), ty, span: e.span, indices: Vec::new() })
                 }
-                Some(Value::Buffer(b, true)) => Some(Place { root: PlaceRoot::Buffer(b), path: Vec::new(), ty: Type::Buffer(self.ir.buffers[b.index()].ty), span: e.span }),
+                Some(Value::Buffer(b, true)) => Some(Place { root: PlaceRoot::Buffer(b), path: Vec::new(), ty: Type::Buffer(self.ir.buffers[b.index()].ty), span: e.span, indices: Vec::new() }),
                 Some(Value::Buffer(_, false)) => input(self, format!("`{}`, a buffer this controller reads", n.text), "only `writes` buffers and `var`s can be assigned; another controller or an external writer owns this one"),
                 Some(Value::Sub) => input(self, format!("subordinate `{}`", n.text), "command a subordinate with `X <- VERB(…)`"),
                 Some(Value::Hook(_)) => input(self, format!("hook `{}`", n.text), "hooks are functions; call them"),
@@ -460,7 +460,21 @@ impl Cx<'_, '_> {
             }
             ast::ExprKind::Index(base, idx) => {
                 let mut p = self.place(base)?;
-                let n = self.const_index(idx)?;
+                let n = match self.index(idx)? {
+                    Subscript::Const(n) => n,
+                    Subscript::Value(i) => {
+                        let Type::Array(elem, _) = p.ty.clone() else {
+                            let t = self.type_name(&p.ty);
+                            self.mismatch(base.span, format!("cannot index into `{t}`"), "not an array".to_string());
+                            return None;
+                        };
+                        p.ty = *elem;
+                        p.path.push(Projection::IndexBy(p.indices.len() as u32));
+                        p.indices.push(i);
+                        p.span = e.span;
+                        return Some(p);
+                    }
+                };
                 match p.ty.clone() {
                     Type::Array(elem, len) => {
                         if n >= len as u64 {

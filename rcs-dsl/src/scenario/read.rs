@@ -498,6 +498,7 @@ impl Resolver<'_> {
             out.error = Some(match x.as_str() {
                 "none" => None,
                 "UNKNOWN_COMMAND" => Some(rcs_runtime::ErrorCode::UNKNOWN_COMMAND.0),
+                "INDEX_RANGE" => Some(rcs_runtime::ErrorCode::INDEX_RANGE.0),
                 name => {
                     let i = self
                         .c

@@ -144,12 +144,24 @@ impl<'a> Values<'a> {
                     ints.extend([t.saturating_sub(1), t, t.saturating_add(1)]);
                 }
             }
+            // An array indexed by a value: its last index and the first
+            // ones past it, so that both in-range and out-of-range indices
+            // (INDEX_RANGE) come up (0 and -1 are always there).
+            ExprKind::IndexBy(ref base, _) => {
+                if let Type::Array(_, n) = base.ty {
+                    let n = i128::from(n);
+                    ints.extend([n - 1, n, n + 1]);
+                }
+            }
             _ => {}
         };
         for p in &c.plans {
             for r in &p.rows {
                 r.visit_exprs(&mut harvest);
             }
+        }
+        for b in c.pre.iter().chain(c.post.iter()) {
+            b.visit_exprs(&mut harvest);
         }
         for v in &c.vars {
             if let Some(e) = &v.init {

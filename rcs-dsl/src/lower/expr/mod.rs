@@ -55,6 +55,14 @@ pub(in crate::lower) struct Cx<'a, 'g> {
     pub(in crate::lower) plan_verbs: Vec<CommandId>,
 }
 
+/// A lowered array index.
+pub(in crate::lower) enum Subscript {
+    /// An integer literal, checked against the array's length.
+    Const(u64),
+    /// A run-time integer value.
+    Value(Expr),
+}
+
 pub(in crate::lower) fn err_expr(span: Span) -> Expr {
     Expr {
         kind: ExprKind::Bool(false),
@@ -298,7 +306,28 @@ impl Cx<'_, '_> {
             ast::ExprKind::Field(base, field) => self.field(base, field, span),
             ast::ExprKind::Index(base, idx) => {
                 let (b, bt) = self.infer(base, None);
-                let n = self.const_index(idx);
+                let n = match self.index(idx) {
+                    Some(Subscript::Value(i)) => {
+                        return match bt {
+                            Ty::Known(Type::Array(elem, _)) => (
+                                mk(ExprKind::IndexBy(Box::new(b), Box::new(i)), (*elem).clone()),
+                                Ty::Known(*elem),
+                            ),
+                            Ty::Err => (err_expr(span), Ty::Err),
+                            t => {
+                                let t = self.ty_name(&t);
+                                self.mismatch(
+                                    base.span,
+                                    format!("cannot index into {t}"),
+                                    "not an array".to_string(),
+                                );
+                                (err_expr(span), Ty::Err)
+                            }
+                        };
+                    }
+                    Some(Subscript::Const(n)) => Some(n),
+                    None => None,
+                };
                 match (bt, n) {
                     (Ty::Err, _) | (_, None) => (err_expr(span), Ty::Err),
                     (Ty::Known(Type::Array(elem, len)), Some(n)) => {

@@ -1,6 +1,6 @@
 //! Stage 2, the expression checker: what names, paths, calls, buffer
 //! fields and subordinate properties stand for, with constant indices
-//! checked against array lengths.
+//! checked against array lengths and run-time indices of integer type.
 
 use super::*;
 use crate::ast;
@@ -9,18 +9,43 @@ use crate::ir::*;
 use crate::source::Span;
 
 impl Cx<'_, '_> {
-    pub(in crate::lower) fn const_index(&mut self, idx: &ast::Expr) -> Option<u64> {
+    /// An array index: an integer literal or constant expression stays a
+    /// constant (checked against the array's length at compile time);
+    /// anything else is a run-time value of an integer type.
+    pub(in crate::lower) fn index(&mut self, idx: &ast::Expr) -> Option<Subscript> {
         match &idx.kind {
-            ast::ExprKind::Int(n) => Some(*n as u64),
-            ast::ExprKind::Paren(inner) => self.const_index(inner),
+            ast::ExprKind::Int(n) => Some(Subscript::Const(*n as u64)),
+            ast::ExprKind::Paren(inner) => self.index(inner),
             _ => {
-                self.mismatch(
-                    idx.span,
-                    "array index must be a constant integer".to_string(),
-                    "not an integer literal".to_string(),
-                );
-                self.help_last("indices are checked at compile time so that no cycle can panic");
-                None
+                let (mut x, t) = self.infer(idx, None);
+                match self.settle(&mut x, &t) {
+                    // A constant expression (`AXES - 1`) is a constant index.
+                    Ty::Known(Type::Int(_)) => match crate::analysis::eval::eval(&x, &|_| None) {
+                        Some(crate::interp::Value::Int(n)) if n >= 0 => {
+                            Some(Subscript::Const(u64::try_from(n).unwrap_or(u64::MAX)))
+                        }
+                        Some(crate::interp::Value::Int(n)) => {
+                            self.mismatch(
+                                idx.span,
+                                format!("index {n} is negative"),
+                                "indices start at 0".to_string(),
+                            );
+                            None
+                        }
+                        _ => Some(Subscript::Value(x)),
+                    },
+                    Ty::Err => None,
+                    t => {
+                        let t = self.ty_name(&t);
+                        self.mismatch(
+                            idx.span,
+                            format!("an array index must be an integer, not {t}"),
+                            "not an integer".to_string(),
+                        );
+                        self.help_last("convert it with `as i64` (or another integer type)");
+                        None
+                    }
+                }
             }
         }
     }

@@ -168,6 +168,12 @@ fn dot_installed() -> bool {
         .is_ok()
 }
 
+/// Graphs per `dot` process. Fixed, not derived from the number of CPUs:
+/// Graphviz draws the first graph of its input with other element ids than
+/// the later ones, so the batches must not depend on the machine (or its
+/// load) for the site to be the same from run to run.
+const GRAPHS_PER_DOT: usize = 16;
+
 /// Every graph as SVG by key, or `None` when Graphviz is missing. The
 /// graphs go to a few `dot` processes at once, many graphs each (one
 /// process per graph costs more than drawing a small graph).
@@ -178,23 +184,37 @@ fn render_all(graphs: &[GraphSource]) -> Result<Option<Svgs>, String> {
     if !dot_installed() {
         return Ok(None);
     }
+    let batches: Vec<&[GraphSource]> = graphs.chunks(GRAPHS_PER_DOT).collect();
     let workers = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1)
-        .clamp(1, 8);
-    let per = graphs.len().div_ceil(workers);
-    let results: Vec<Result<Vec<String>, String>> = std::thread::scope(|s| {
-        let handles: Vec<_> = graphs
-            .chunks(per)
-            .map(|chunk| s.spawn(move || render_batch(chunk)))
+        .clamp(1, 8)
+        .min(batches.len());
+    // Worker `w` draws batches w, w + workers, …; the results are put back
+    // in batch order, so only the speed depends on the number of workers.
+    let mut results: Vec<Option<Result<Vec<String>, String>>> = vec![None; batches.len()];
+    std::thread::scope(|s| {
+        let handles: Vec<_> = (0..workers)
+            .map(|w| {
+                let batches = &batches;
+                s.spawn(move || {
+                    (w..batches.len())
+                        .step_by(workers)
+                        .map(|i| (i, render_batch(batches[i])))
+                        .collect::<Vec<_>>()
+                })
+            })
             .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-            .collect()
+        for h in handles {
+            let done = h.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
+            for (i, r) in done {
+                results[i] = Some(r);
+            }
+        }
     });
     let mut svgs = Svgs::new();
-    for (chunk, svg) in graphs.chunks(per).zip(results) {
+    for (chunk, svg) in batches.into_iter().zip(results) {
+        let svg = svg.ok_or_else(|| "a batch of graphs was not drawn".to_string())?;
         for (g, svg) in chunk.iter().zip(svg?) {
             svgs.insert(g.key.clone(), svg);
         }

@@ -34,6 +34,19 @@ fn coverage_lines(out: &str) -> Vec<(String, usize, usize)> {
         .collect()
 }
 
+/// Every plan set under `plans/`.
+const PLAN_SETS: [&str; 4] = [
+    "plans/bridgeport_io",
+    "plans/figure13",
+    "plans/rcs_ex",
+    "plans/submarine",
+];
+
+/// The plans (coverage lines) of all of them: bridgeport_io 39 (TOOL 17,
+/// SPINDLE 9, AUX 6, COOLANT 5, LUBE 2), figure13 1 (GX), rcs_ex 9 (EMOVE 3,
+/// PRIM 2, SERVO 2, TOOL 2), submarine 9 (SM 2, PR 3, TB 4).
+const PLANS: usize = 39 + 1 + 9 + 9;
+
 fn assert_full_coverage(out: &str, plans: usize) {
     let lines = coverage_lines(out);
     assert_eq!(lines.len(), plans, "one line per plan:\n{out}");
@@ -45,18 +58,20 @@ fn assert_full_coverage(out: &str, plans: usize) {
 
 #[test]
 fn the_project_scenarios_pass_on_the_interpreter_with_every_row_covered() {
-    let out = rcsc(&["test", "plans/submarine", "plans/figure13", "--coverage"]);
+    let out = rcsc(&["test", "plans/", "--coverage"]);
     let stdout = text(&out.stdout);
     assert_eq!(out.status.code(), Some(0), "{stdout}{}", text(&out.stderr));
-    let n = scenario_count("plans/submarine") + scenario_count("plans/figure13");
+    let n = PLAN_SETS
+        .iter()
+        .map(|set| scenario_count(set))
+        .sum::<usize>();
     assert!(n >= 30, "the plans have their scenarios");
     assert_eq!(stdout.lines().filter(|l| l.ends_with("... ok")).count(), n);
     assert_eq!(
         stdout.lines().last(),
         Some(&*format!("{n} passed, 0 failed"))
     );
-    // SM 2 + PR 3 + TB 4 plans, GX 1.
-    assert_full_coverage(&stdout, 10);
+    assert_full_coverage(&stdout, PLANS);
     assert!(
         text(&out.stderr).contains("Running"),
         "status lines on stderr"
@@ -236,10 +251,10 @@ fn the_compiled_backend_gives_the_same_results_as_the_interpreter() {
         let out = rcsc(&all);
         (out.status.code(), text(&out.stdout), text(&out.stderr))
     };
-    let sets = ["plans/submarine", "plans/figure13", "--coverage"];
+    let sets = ["plans/", "--coverage"];
     let (code, compiled, stderr) = run("compiled", &sets);
     assert_eq!(code, Some(0), "{compiled}{stderr}");
-    assert_full_coverage(&compiled, 10);
+    assert_full_coverage(&compiled, PLANS);
     let (_, interp, _) = run("interp", &sets);
     assert_eq!(compiled, interp, "identical reports on both backends");
 

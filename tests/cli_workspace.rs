@@ -15,6 +15,14 @@ fn files(dir: &Path) -> BTreeSet<String> {
     tree(dir).into_keys().collect()
 }
 
+/// The generated Rust of `plans/`: one file per set, in path order.
+const ALL_RUST: [&str; 4] = [
+    "bridgeport_io/rust/bridgeport_io.rs",
+    "figure13/rust/figure13.rs",
+    "rcs_ex/rust/rcs_ex.rs",
+    "submarine/rust/submarine.rs",
+];
+
 /// The generated Rust files of a build, i.e. which systems it wrote where.
 fn rust_files(dir: &Path) -> Vec<String> {
     files(dir)
@@ -35,21 +43,25 @@ fn building_plans_builds_each_set_into_its_own_folder_with_its_own_schedule() {
     let err = text(&o.stderr);
     assert!(err.contains("    Checking figure13 (1 file)\n"), "{err}");
     assert!(err.contains("    Checking submarine (3 files)\n"), "{err}");
-    assert_eq!(
-        rust_files(&out),
-        ["figure13/rust/figure13.rs", "submarine/rust/submarine.rs"]
+    assert!(err.contains("    Checking rcs_ex (4 files)\n"), "{err}");
+    assert!(
+        err.contains("    Checking bridgeport_io (5 files)\n"),
+        "{err}"
     );
+    assert_eq!(rust_files(&out), ALL_RUST);
     // Each set keeps its own manifest: submarine's 30 ms CPU, figure13's default 10 ms.
     let sub = std::fs::read_to_string(out.join("submarine/rust/submarine.rs")).unwrap();
     let fig = std::fs::read_to_string(out.join("figure13/rust/figure13.rs")).unwrap();
     assert!(sub.contains("from_nanos(30000000u64)"), "30 ms period");
     assert!(fig.contains("from_nanos(10000000u64)"), "10 ms period");
-    // The same tree as naming the two sets.
+    // The same tree as naming the sets.
     let named = scratch("plans-named", &[]);
     let o = rcsc(&[
         "build",
         "plans/submarine",
         "plans/figure13",
+        "plans/rcs_ex",
+        "plans/bridgeport_io",
         "-o",
         s(&named),
     ]);
@@ -68,15 +80,14 @@ fn the_repository_root_is_a_workspace_of_plans() {
     let out = scratch("root", &[]);
     let o = rcsc(&["build", "-o", s(&out)]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
-    assert_eq!(
-        rust_files(&out),
-        ["figure13/rust/figure13.rs", "submarine/rust/submarine.rs"]
-    );
+    assert_eq!(rust_files(&out), ALL_RUST);
     let o = rcsc(&["test"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
     let err = text(&o.stderr);
     assert!(err.contains("scenarios of figure13"), "{err}");
     assert!(err.contains("scenarios of submarine"), "{err}");
+    assert!(err.contains("scenarios of rcs_ex"), "{err}");
+    assert!(err.contains("scenarios of bridgeport_io"), "{err}");
     let _ = std::fs::remove_dir_all(&out);
 }
 
@@ -241,17 +252,25 @@ fn graph_ir_and_test_take_a_workspace() {
         .iter()
         .map(|i| i["system"].as_str().unwrap())
         .collect();
-    assert_eq!(systems, ["figure13", "submarine"]);
+    assert_eq!(
+        systems,
+        ["bridgeport_io", "figure13", "rcs_ex", "submarine"]
+    );
     let o = rcsc(&["test", "plans"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
-    let scenarios = ["plans/submarine", "plans/figure13"]
-        .iter()
-        .map(|set| {
-            std::fs::read_dir(Path::new(set).join("scenarios"))
-                .unwrap()
-                .count()
-        })
-        .sum::<usize>();
+    let scenarios = [
+        "plans/submarine",
+        "plans/figure13",
+        "plans/rcs_ex",
+        "plans/bridgeport_io",
+    ]
+    .iter()
+    .map(|set| {
+        std::fs::read_dir(Path::new(set).join("scenarios"))
+            .unwrap()
+            .count()
+    })
+    .sum::<usize>();
     let want = format!("{scenarios} passed, 0 failed\n");
     assert!(text(&o.stdout).ends_with(&want), "{}", text(&o.stdout));
 }

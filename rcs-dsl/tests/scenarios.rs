@@ -20,7 +20,12 @@ fn scenario_file(path: &str) -> SourceFile {
 #[test]
 fn every_plan_scenario_passes() {
     let mut ran = 0;
-    for set in ["../plans/submarine", "../plans/figure13"] {
+    for set in [
+        "../plans/submarine",
+        "../plans/figure13",
+        "../plans/rcs_ex",
+        "../plans/bridgeport_io",
+    ] {
         let loaded = load_folder(Path::new(set)).expect("plans");
         let ir = check(&loaded, &Options::default()).ir.expect("clean");
         let dir = Path::new(set).join("scenarios");

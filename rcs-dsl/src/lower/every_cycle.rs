@@ -244,25 +244,11 @@ impl Cx<'_, '_> {
             );
             return None;
         }
-        let Some(i) = self.names().errors.get(&code.text) else {
-            self.diags.push(
-                Diagnostic::error(
-                    Code::UnknownName,
-                    format!(
-                        "controller `{}` has no error code `{}`",
-                        self.c.name, code.text
-                    ),
-                    code.span,
-                    "not declared",
-                )
-                .with_help(format!("declare it: `error {}`", code.text)),
-            );
-            return None;
-        };
+        let error = Some(self.error_code(code)?);
         Some(Job::Report {
             status: StatusId::ERROR,
             span,
-            error: Some(ErrorId(i as u32)),
+            error,
         })
     }
 }

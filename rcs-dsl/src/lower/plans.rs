@@ -101,24 +101,7 @@ impl Cx<'_, '_> {
         let to = match &r.target {
             ast::Target::Same(_) => Target::Same,
             ast::Target::Error(None, _) => Target::Error(None),
-            ast::Target::Error(Some(code), _) => match self.names().errors.get(&code.text) {
-                Some(i) => Target::Error(Some(ErrorId(i as u32))),
-                None => {
-                    self.diags.push(
-                        Diagnostic::error(
-                            Code::UnknownName,
-                            format!(
-                                "controller `{}` has no error code `{}`",
-                                self.c.name, code.text
-                            ),
-                            code.span,
-                            "not declared",
-                        )
-                        .with_help(format!("declare it: `error {}`", code.text)),
-                    );
-                    Target::Error(None)
-                }
-            },
+            ast::Target::Error(Some(code), _) => Target::Error(self.error_code(code)),
             ast::Target::State(n) if n.text == "Done" => Target::Done,
             ast::Target::State(n) => Target::State(intern(states, n)),
         };
@@ -506,5 +489,28 @@ pub fn has_new_command_conjunct(e: &Expr) -> bool {
             has_new_command_conjunct(l) || has_new_command_conjunct(r)
         }
         _ => false,
+    }
+}
+
+impl Cx<'_, '_> {
+    /// The controller's error code `code` (in `-> Error(CODE)` and
+    /// `report ERROR(CODE)`), or `None` after reporting it undeclared.
+    pub(in crate::lower) fn error_code(&mut self, code: &ast::Name) -> Option<ErrorId> {
+        let Some(i) = self.names().errors.get(&code.text) else {
+            self.diags.push(
+                Diagnostic::error(
+                    Code::UnknownName,
+                    format!(
+                        "controller `{}` has no error code `{}`",
+                        self.c.name, code.text
+                    ),
+                    code.span,
+                    "not declared",
+                )
+                .with_help(format!("declare it: `error {}`", code.text)),
+            );
+            return None;
+        };
+        Some(ErrorId(i as u32))
     }
 }

@@ -416,20 +416,22 @@ impl<'ir> PlanAnalysis<'ir> {
         if !covers(&self.plan.rows[row].from, state) {
             return None;
         }
-        let mut parts = Vec::new();
-        let earlier: Vec<usize> = match &self.conds[row] {
+        let mut parts = Vec::with_capacity(row + 1);
+        // The rows that must not match: the earlier ones, or for
+        // `otherwise` every other row.
+        let others = match &self.conds[row] {
             Some(c) => {
                 parts.push(Formula::Shared(c.clone()));
-                (0..row).collect()
+                0..row
             }
             // Only the first `otherwise` can fire (a second one is an
             // error, `otherwise_not_last`, but the graph still asks).
             None if self.plan.rows[..row].iter().any(|r| r.is_otherwise()) => {
                 return Some(Formula::Const(false));
             }
-            None => (0..self.plan.rows.len()).filter(|i| *i != row).collect(),
+            None => 0..self.plan.rows.len(),
         };
-        for i in earlier {
+        for i in others.filter(|&i| i != row) {
             if let (Some(c), true) = (&self.conds[i], covers(&self.plan.rows[i].from, state)) {
                 parts.push(Formula::Not(Box::new(Formula::Shared(c.clone()))));
             }

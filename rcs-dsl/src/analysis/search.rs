@@ -26,7 +26,8 @@ pub enum Mode {
 pub enum Outcome {
     /// No assignment satisfies the formula (a proof only in `Prove` mode).
     None,
-    /// An assignment: a value per leaf (`None`: any value will do).
+    /// An assignment: a value per leaf (`None`: any value will do); empty
+    /// in `Prove` mode, where only its existence matters.
     Found(Vec<Option<Value>>),
     /// The budget ran out.
     Unknown,
@@ -38,18 +39,46 @@ pub struct Search<'a> {
     /// `Prove` only: per exact atom, its truth value on each cell of its
     /// leaf (one leaf; constant atoms have one entry).
     tables: &'a [Option<Vec<bool>>],
-    /// `Prove` only: the cell index each assigned leaf is in.
-    cell: Vec<usize>,
     /// Per leaf, the values to try.
     domains: &'a [Vec<Value>],
-    leaves: Vec<Option<Value>>,
-    opaque: Vec<Option<bool>>,
-    /// Search variables in order: leaves, then opaque atoms (`Prove`).
-    order: Vec<Var>,
+    /// The assignment under construction and the search order.
+    buf: Buffers,
     nodes: u64,
     new_command: Option<LeafId>,
     state_cycles: Option<LeafId>,
     plan_cycles: Option<LeafId>,
+}
+
+/// The vectors one search works in. A plan set's analysis asks tens of
+/// thousands of questions, and allocating these afresh for each was over a
+/// quarter of `check`'s allocations: a finished search hands them to the
+/// next one on the same thread (see [`SPARE`]).
+#[derive(Default)]
+struct Buffers {
+    /// Per leaf, its value so far (`None`: unassigned).
+    leaves: Vec<Option<Value>>,
+    /// `Prove` only: the cell index each assigned leaf is in.
+    cell: Vec<usize>,
+    /// Per opaque atom, its truth value so far (`Prove`).
+    opaque: Vec<Option<bool>>,
+    /// Search variables in order: leaves, then opaque atoms (`Prove`).
+    order: Vec<Var>,
+    /// The atoms the formula reads.
+    atoms: Vec<usize>,
+}
+
+thread_local! {
+    /// Buffers of finished searches, for the next search on this thread.
+    /// A pool rather than one slot: a search may run while another is
+    /// alive.
+    static SPARE: std::cell::RefCell<Vec<Buffers>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+impl Drop for Search<'_> {
+    fn drop(&mut self) {
+        let buf = std::mem::take(&mut self.buf);
+        SPARE.with(|spare| spare.borrow_mut().push(buf));
+    }
 }
 
 #[derive(Clone, Copy)]
@@ -68,12 +97,21 @@ impl<'a> Search<'a> {
         tables: &'a [Option<Vec<bool>>],
         fixed: &[(LeafId, Value)],
     ) -> Search<'a> {
-        let mut leaves = vec![None; terms.leaves.len()];
-        let mut cell = vec![0; terms.leaves.len()];
+        let mut buf = SPARE
+            .with(|spare| spare.borrow_mut().pop())
+            .unwrap_or_default();
+        buf.leaves.clear();
+        buf.leaves.resize(terms.leaves.len(), None);
+        buf.cell.clear();
+        buf.cell.resize(terms.leaves.len(), 0);
+        buf.opaque.clear();
+        buf.opaque.resize(terms.atoms.len(), None);
+        buf.order.clear();
+        buf.atoms.clear();
         for (l, v) in fixed {
-            leaves[*l] = Some(v.clone());
+            buf.leaves[*l] = Some(v.clone());
             if mode == Mode::Prove {
-                cell[*l] = cell_of(terms, tables, domains, *l, v);
+                buf.cell[*l] = cell_of(terms, tables, domains, *l, v);
             }
         }
         let find = |l: Leaf| terms.find(&l);
@@ -81,11 +119,8 @@ impl<'a> Search<'a> {
             terms,
             mode,
             tables,
-            cell,
             domains,
-            leaves,
-            opaque: vec![None; terms.atoms.len()],
-            order: Vec::new(),
+            buf,
             nodes: 0,
             new_command: find(Leaf::NewCommand),
             state_cycles: find(Leaf::StateCycles),
@@ -94,20 +129,18 @@ impl<'a> Search<'a> {
     }
 
     pub fn run(mut self, f: &Formula) -> Outcome {
-        // Only what the formula reads is searched over.
-        let mut atoms = Vec::new();
+        // Only what the formula reads is searched over: first the leaves
+        // of the atoms that are evaluated, then (`Prove`) the opaque atoms.
+        let mut atoms = std::mem::take(&mut self.buf.atoms);
         collect_atoms(f, &mut atoms);
-        let mut leaves: Vec<LeafId> = Vec::new();
+        let prove = self.mode == Mode::Prove;
         for &a in &atoms {
             let atom = &self.terms.atoms[a];
-            if self.mode == Mode::Prove && !atom.exact {
-                self.order.push(Var::Atom(a));
+            if prove && !atom.exact {
                 continue;
             }
             for &l in &atom.leaves {
-                if !leaves.contains(&l) && self.leaves[l].is_none() {
-                    leaves.push(l);
-                }
+                self.push_leaf(l);
             }
         }
         if self.mode == Mode::Witness {
@@ -116,18 +149,36 @@ impl<'a> Search<'a> {
                 .into_iter()
                 .flatten()
             {
-                if !leaves.contains(&l) && self.leaves[l].is_none() {
-                    leaves.push(l);
+                self.push_leaf(l);
+            }
+        }
+        if prove {
+            for &a in &atoms {
+                if !self.terms.atoms[a].exact {
+                    self.buf.order.push(Var::Atom(a));
                 }
             }
         }
-        let mut order: Vec<Var> = leaves.into_iter().map(Var::Leaf).collect();
-        order.append(&mut self.order);
-        self.order = order;
+        self.buf.atoms = atoms;
         match self.dfs(f, 0) {
-            Ok(true) => Outcome::Found(self.leaves),
+            // A proof's assignment is over cells, not values: nobody reads
+            // it, so it is not copied out.
+            Ok(true) if prove => Outcome::Found(Vec::new()),
+            Ok(true) => Outcome::Found(self.buf.leaves.clone()),
             Ok(false) => Outcome::None,
             Err(()) => Outcome::Unknown,
+        }
+    }
+
+    /// Adds leaf `l` to the search order unless it is fixed or already in.
+    fn push_leaf(&mut self, l: LeafId) {
+        let listed = self
+            .buf
+            .order
+            .iter()
+            .any(|v| matches!(v, Var::Leaf(x) if *x == l));
+        if !listed && self.buf.leaves[l].is_none() {
+            self.buf.order.push(Var::Leaf(l));
         }
     }
 
@@ -139,28 +190,28 @@ impl<'a> Search<'a> {
         let verdict = and3(self.value(f), self.consistent());
         match verdict {
             Some(v) => return Ok(v),
-            None if depth == self.order.len() => return Ok(false),
+            None if depth == self.buf.order.len() => return Ok(false),
             None => {}
         }
-        match self.order[depth] {
+        match self.buf.order[depth] {
             Var::Leaf(l) => {
                 for (i, v) in self.domains[l].iter().enumerate() {
-                    self.leaves[l] = Some(v.clone());
-                    self.cell[l] = i;
+                    self.buf.leaves[l] = Some(v.clone());
+                    self.buf.cell[l] = i;
                     if self.dfs(f, depth + 1)? {
                         return Ok(true);
                     }
                 }
-                self.leaves[l] = None;
+                self.buf.leaves[l] = None;
             }
             Var::Atom(a) => {
                 for b in [true, false] {
-                    self.opaque[a] = Some(b);
+                    self.buf.opaque[a] = Some(b);
                     if self.dfs(f, depth + 1)? {
                         return Ok(true);
                     }
                 }
-                self.opaque[a] = None;
+                self.buf.opaque[a] = None;
             }
         }
         Ok(false)
@@ -202,20 +253,20 @@ impl<'a> Search<'a> {
         let atom = &self.terms.atoms[a];
         if self.mode == Mode::Prove {
             if !atom.exact {
-                return self.opaque[a];
+                return self.buf.opaque[a];
             }
             // Exact: a table lookup on the cell of its one leaf.
             let table = self.tables[a].as_ref()?;
             return match atom.leaves.as_slice() {
                 [] => table.first().copied(),
                 [l] => {
-                    self.leaves[*l].as_ref()?;
-                    table.get(self.cell[*l]).copied()
+                    self.buf.leaves[*l].as_ref()?;
+                    table.get(self.buf.cell[*l]).copied()
                 }
                 _ => None,
             };
         }
-        let lookup = |l: &Leaf| self.leaves[self.terms.find(l)?].clone();
+        let lookup = |l: &Leaf| self.buf.leaves[self.terms.find(l)?].clone();
         match eval(&atom.expr, &lookup)? {
             Value::Bool(b) => Some(b),
             _ => None,
@@ -229,7 +280,7 @@ impl<'a> Search<'a> {
         if self.mode == Mode::Prove {
             return Some(true);
         }
-        let get = |l: Option<LeafId>| l.map(|i| self.leaves[i].clone());
+        let get = |l: Option<LeafId>| l.map(|i| self.buf.leaves[i].clone());
         let int = |v: Option<Option<Value>>| match v {
             Some(Some(Value::Int(i))) => Some(Some(i)),
             Some(None) => Some(None),

@@ -94,13 +94,31 @@ impl Terms {
         match &e.kind {
             ExprKind::Bool(b) => Formula::Const(*b),
             ExprKind::Unary(UnOp::Not, x) => Formula::Not(Box::new(self.formula(x))),
-            ExprKind::Binary(BinOp::And, l, r) => {
-                Formula::And(vec![self.formula(l), self.formula(r)])
+            // A chain `a && b && c` is one n-ary node (both connectives are
+            // associative in three-valued logic too): one vector instead of
+            // a tree of two-element ones, and a flatter walk per search node.
+            ExprKind::Binary(BinOp::And, ..) => {
+                let mut xs = Vec::new();
+                self.chain(e, BinOp::And, &mut xs);
+                Formula::And(xs)
             }
-            ExprKind::Binary(BinOp::Or, l, r) => {
-                Formula::Or(vec![self.formula(l), self.formula(r)])
+            ExprKind::Binary(BinOp::Or, ..) => {
+                let mut xs = Vec::new();
+                self.chain(e, BinOp::Or, &mut xs);
+                Formula::Or(xs)
             }
             _ => Formula::Atom(self.atom(e)),
+        }
+    }
+
+    /// The operands of a chain of `op` (left to right), as formulas.
+    fn chain(&mut self, e: &Expr, op: BinOp, out: &mut Vec<Formula>) {
+        match &e.kind {
+            ExprKind::Binary(o, l, r) if *o == op => {
+                self.chain(l, op, out);
+                self.chain(r, op, out);
+            }
+            _ => out.push(self.formula(e)),
         }
     }
 

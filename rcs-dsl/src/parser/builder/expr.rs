@@ -90,6 +90,11 @@ impl Builder {
                 _ => {}
             }
         }
+        if !failed && ops.is_empty() {
+            // One operand and no operator (most arguments and assigned
+            // values): no stack needed.
+            return self.operand(parts, depth).0;
+        }
         if !failed {
             operands.push(self.operand(parts, depth));
         }
@@ -142,13 +147,15 @@ impl Builder {
     pub(in crate::parser) fn postfix(&mut self, p: Pair<Rule>, depth: usize) -> (Expr, usize) {
         let mut inner = p.into_inner();
         let first = inner.next().expect("primary");
-        let suffixes: Vec<Pair<Rule>> = inner.collect();
-        if suffixes.len() + depth > MAX_EXPR_DEPTH {
+        // Counted on a copy of the iterator (cheap) rather than collected:
+        // most operands have a suffix, and collecting allocated for each.
+        let count = inner.clone().count();
+        if count + depth > MAX_EXPR_DEPTH {
             let span = self.span(&first);
             return (self.too_deep(span), 1);
         }
-        let (mut e, mut h) = self.primary(first, depth + suffixes.len());
-        let mut suffixes = suffixes.into_iter().peekable();
+        let (mut e, mut h) = self.primary(first, depth + count);
+        let mut suffixes = inner.peekable();
         // `cmd.P`: the command parameter, not a field of something named `cmd`.
         if matches!(&e.kind, ExprKind::Path(None, n) if n.text == "cmd") {
             let param = suffixes
@@ -156,7 +163,7 @@ impl Builder {
                     s.clone()
                         .into_inner()
                         .next()
-                        .is_some_and(|c| c.as_rule() == Rule::ident)
+                        .is_some_and(|c| c.as_rule() == Rule::ident && !is_field_keyword(&c))
                 })
                 .map(|s| s.into_inner().next().expect("field name"));
             match param {
@@ -185,7 +192,7 @@ impl Builder {
             let c = s.into_inner().next().expect("suffix has one child");
             e = match c.as_rule() {
                 // `status` and `error` are keywords but valid after a dot.
-                Rule::kw_status | Rule::kw_error => Expr {
+                Rule::ident if is_field_keyword(&c) => Expr {
                     kind: ExprKind::Field(
                         Box::new(e),
                         Name {
@@ -281,4 +288,10 @@ impl Builder {
         };
         (Expr { kind, span }, height)
     }
+}
+
+/// `status` or `error` after a dot: a subordinate's status or error code,
+/// not a user-chosen name (so not refused as a reserved word).
+fn is_field_keyword(p: &Pair<Rule>) -> bool {
+    matches!(p.as_str(), "status" | "error")
 }

@@ -8,7 +8,13 @@ impl Builder {
         let span = self.span(&p);
         let mut docs = Vec::new();
         let mut label = None;
-        let mut body = Vec::new();
+        let mut from = None;
+        let mut otherwise = None;
+        let mut when = None;
+        let mut cond = None;
+        let mut cond_span = span;
+        let mut target = None;
+        let mut jobs = Vec::new();
         for c in p.into_inner() {
             match c.as_rule() {
                 Rule::doc_comment => docs.push(Self::doc(&c)),
@@ -17,18 +23,6 @@ impl Builder {
                     let n = c.as_str()[1..].parse::<u64>().unwrap_or(u64::MAX);
                     label = Some((n, s));
                 }
-                _ => body.push(c),
-            }
-        }
-        let mut from = None;
-        let mut otherwise = None;
-        let mut when = None;
-        let mut cond = None;
-        let mut cond_span = span;
-        let mut target = None;
-        let mut jobs = Vec::new();
-        for c in body {
-            match c.as_rule() {
                 Rule::from_state => {
                     let c = c.into_inner().next().expect("from has one child");
                     from = Some(match c.as_rule() {

@@ -76,23 +76,14 @@ pub fn check(set: &PlanSet, options: &Options) -> Checked {
     let Some(files) = parse(set, &mut diags) else {
         return finish(None, diags);
     };
-    let Some(ir) = lower_files(set, &files, &mut diags) else {
+    let Some(ir) = lower_files(set, files, &mut diags) else {
         return finish(None, diags);
     };
     let mut levels = LintLevels::default();
     for &(lint, level) in set.manifest.lints.iter().chain(&options.lint_flags) {
         levels.set(lint, level);
     }
-    std::thread::scope(|scope| {
-        // Freeing a large AST is a visible share of `check`: it happens
-        // beside the checks instead of before them.
-        if rcs_bytes(set) >= PARALLEL_BYTES {
-            scope.spawn(move || drop(files));
-        } else {
-            drop(files);
-        }
-        checks::run(&ir, &levels, &set.sources, &mut diags);
-    });
+    checks::run(&ir, &levels, &set.sources, &mut diags);
     let ir = (!diags.has_errors()).then_some(ir);
     finish(ir, diags)
 }
@@ -108,7 +99,7 @@ pub fn lower_unchecked(set: &PlanSet) -> Option<ir::Ir> {
 /// Stages 0–2: the load diagnostics, parsing and lowering.
 fn front(set: &PlanSet, diags: &mut Diagnostics) -> Option<ir::Ir> {
     let files = parse(set, diags)?;
-    lower_files(set, &files, diags)
+    lower_files(set, files, diags)
 }
 
 /// Stages 0 and 1: the load diagnostics and parsing; `None` on an error.
@@ -145,7 +136,7 @@ fn parse(set: &PlanSet, diags: &mut Diagnostics) -> Option<Vec<ast::File>> {
 }
 
 /// Stage 2: lowering parsed files; `None` on an error.
-fn lower_files(set: &PlanSet, files: &[ast::File], diags: &mut Diagnostics) -> Option<ir::Ir> {
+fn lower_files(set: &PlanSet, files: Vec<ast::File>, diags: &mut Diagnostics) -> Option<ir::Ir> {
     let system = set
         .manifest
         .system

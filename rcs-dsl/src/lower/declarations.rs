@@ -221,7 +221,11 @@ pub(super) fn lower_controller_body(
     ir: &Ir,
     id: CtrlId,
     c: &ast::ControllerDef,
+    plan_rows: Vec<Vec<ast::Row>>,
 ) -> ControllerBody {
+    // The rows of each plan entry, in order (taken out of the AST: see
+    // `take_plan_rows`); each is dropped once its plan is lowered.
+    let mut plan_rows = plan_rows.into_iter();
     let mut diags = Diagnostics::new();
     let diags = &mut diags;
     let mut inits = Vec::new();
@@ -284,6 +288,7 @@ pub(super) fn lower_controller_body(
                     inits.push((vi, e));
                 }
                 ast::EntryKind::Plan(p) => {
+                    let rows = plan_rows.next().unwrap_or_default();
                     let Some(verbs) = cx.plan_verbs(p, &plan_of, &plans) else {
                         continue;
                     };
@@ -291,7 +296,7 @@ pub(super) fn lower_controller_body(
                     cx.const_ctx = false;
                     cx.plan_cmd = Some(cmd);
                     cx.plan_verbs = verbs.clone();
-                    let mut plan = cx.plan(p, cmd, &e.outer);
+                    let mut plan = cx.plan(p, rows, cmd, &e.outer);
                     for v in &verbs {
                         plan_of[v.index()] = Some(PlanId(plans.len() as u32));
                     }

@@ -30,6 +30,7 @@ use crate::manifest::{Manifest, DEFAULT_PERIOD_NS};
 use crate::source::{SourceMap, Span};
 use petgraph::graph::{DiGraph, NodeIndex};
 use std::collections::BTreeMap;
+use std::sync::Mutex;
 
 /// What a global name stands for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,9 +80,37 @@ pub(crate) const PRIMITIVES: [&str; 11] = [
     "bool", "i8", "i16", "i32", "i64", "u8", "u16", "u32", "u64", "f32", "f64",
 ];
 
+/// One controller body to lower on a worker: the controller, its header,
+/// and its plans' rows (taken by the worker that lowers them).
+type BodyWork<'a> = (CtrlId, &'a ast::ControllerDef, Mutex<Vec<Vec<ast::Row>>>);
+
+/// Takes every plan's rows out of the AST, per controller (by its span)
+/// in the order of its plans. The rows are most of the AST; lowering a
+/// controller's body consumes its rows, so they are freed, on the worker
+/// that lowered them, as its IR is built rather than after the whole plan
+/// set: the peak of memory — and the page faults of first touching it, a
+/// sixth of `check`'s time on a large set — is the AST, not AST plus IR.
+fn take_plan_rows(files: &mut [ast::File]) -> BTreeMap<Span, Vec<Vec<ast::Row>>> {
+    let mut out = BTreeMap::new();
+    for item in files.iter_mut().flat_map(|f| &mut f.items) {
+        if let ast::Item::Controller(c) = item {
+            let rows = c
+                .entries
+                .iter_mut()
+                .filter_map(|e| match &mut e.kind {
+                    ast::EntryKind::Plan(p) => Some(std::mem::take(&mut p.rows)),
+                    _ => None,
+                })
+                .collect();
+            out.insert(c.span, rows);
+        }
+    }
+    out
+}
+
 /// Lower parsed files (already in path order) to the IR.
 pub fn lower(
-    files: &[ast::File],
+    mut files: Vec<ast::File>,
     file_names: Vec<String>,
     manifest: &Manifest,
     system: &str,
@@ -89,7 +118,8 @@ pub fn lower(
     diags: &mut Diagnostics,
 ) -> Option<Ir> {
     let start = diags.len();
-    let mut globals = collect_items(files, diags);
+    let mut plan_rows = take_plan_rows(&mut files);
+    let mut globals = collect_items(&files, diags);
     let mut ir = Ir {
         system: system.to_string(),
         files: file_names,
@@ -110,16 +140,20 @@ pub fn lower(
     // Controller bodies only read the declarations lowered so far, so they
     // are lowered in parallel; their plans and diagnostics are put back in
     // controller order.
-    let ids: Vec<(CtrlId, &ast::ControllerDef)> = ctrl_asts
+    let ids: Vec<BodyWork> = ctrl_asts
         .iter()
         .enumerate()
-        .map(|(i, c)| (CtrlId(i as u32), *c))
+        .map(|(i, c)| {
+            let rows = plan_rows.remove(&c.span).unwrap_or_default();
+            (CtrlId(i as u32), *c, Mutex::new(rows))
+        })
         .collect();
-    let rows: usize = ids.iter().map(|(_, c)| c.entries.len()).sum();
-    let bodies = crate::parallel::map_ordered(&ids, rows >= 2048, |&(id, c)| {
-        declarations::lower_controller_body(&globals, &names, &ir, id, c)
+    let rows: usize = ids.iter().map(|(_, c, _)| c.entries.len()).sum();
+    let bodies = crate::parallel::map_ordered(&ids, rows >= 2048, |(id, c, rows)| {
+        let rows = std::mem::take(&mut *rows.lock().unwrap_or_else(|e| e.into_inner()));
+        declarations::lower_controller_body(&globals, &names, &ir, *id, c, rows)
     });
-    for ((id, _), mut body) in ids.iter().zip(bodies) {
+    for ((id, _, _), mut body) in ids.iter().zip(bodies) {
         diags.extend(std::mem::take(&mut body.diags));
         body.apply(&mut ir.controllers[id.index()]);
     }

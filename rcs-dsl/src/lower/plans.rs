@@ -13,6 +13,7 @@ impl Cx<'_, '_> {
     pub(in crate::lower) fn plan(
         &mut self,
         p: &ast::PlanDef,
+        ast_rows: Vec<ast::Row>,
         cmd: CommandId,
         outer: &ast::Outer,
     ) -> Plan {
@@ -23,13 +24,12 @@ impl Cx<'_, '_> {
         let mut names = ByName::default();
         names.first_or_insert("S0", 0);
         let mut rows = Vec::new();
-        for (pos, r) in p.rows.iter().enumerate() {
+        for (pos, r) in ast_rows.iter().enumerate() {
             if let Some(row) = self.row(r, pos as u32, (&mut states, &mut names)) {
                 rows.push(row);
             }
         }
-        let span = p
-            .rows
+        let span = ast_rows
             .last()
             .map(|r| p.header.to(r.span))
             .unwrap_or(p.header);

@@ -87,11 +87,19 @@ impl Gen<'_> {
         let (root, mut ty) = self.place_root(place);
         let mut path = root;
         let mut opened = Vec::new();
+        // Right after an `element_mut`, the path is the slot it opened:
+        // `(*slot)` as a whole, plain `slot` before a field (auto-deref,
+        // which clippy wants spelt so).
+        let mut slot_opened: Option<proc_macro2::Ident> = None;
         for proj in &place.path {
+            let base = match slot_opened.take() {
+                Some(slot) if matches!(proj, Projection::Field(_)) => quote!(#slot),
+                _ => path.clone(),
+            };
             match (proj, &ty) {
                 (Projection::Field(f), Type::Buffer(bt)) => {
                     let field = &self.names.buffers[bt.index()].fields[*f as usize];
-                    path = quote!(#path.#field);
+                    path = quote!(#base.#field);
                     ty = self.ir.buffer_types[bt.index()].fields[*f as usize]
                         .ty
                         .clone();
@@ -106,6 +114,7 @@ impl Gen<'_> {
                     let at = &locals[*k as usize];
                     opened.push(quote!(rt::index::element_mut(&mut #path, #at, &mut self.bk)));
                     path = quote!((*#slot));
+                    slot_opened = Some(slot);
                     ty = (**elem).clone();
                 }
                 _ => unreachable!("projections follow the place's type"),

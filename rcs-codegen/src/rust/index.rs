@@ -177,19 +177,17 @@ pub(super) fn cycle_steps(c: &Controller, post: TokenStream) -> (TokenStream, To
     )
 }
 
-/// Whether any expression of the controller indexes by a run-time value.
+/// Whether anything the controller evaluates can index by a run-time
+/// value: an expression, or the place a job assigns (`t.rows[i].x = …`
+/// holds no index expression, yet can meet an index out of range).
 fn indexes_by_value(c: &Controller) -> bool {
-    let mut found = false;
-    let mut see = |e: &Expr| found |= matches!(e.kind, ExprKind::IndexBy(..));
-    for b in c.pre.iter().chain(c.post.iter()) {
-        b.visit_exprs(&mut see);
-    }
-    for p in &c.plans {
-        for r in &p.rows {
-            r.visit_exprs(&mut see);
-        }
-    }
-    found
+    let rows = || c.plans.iter().flat_map(|p| &p.rows);
+    let blocks = c.pre.iter().chain(c.post.iter()).map(|b| &b.jobs);
+    let in_jobs = blocks
+        .chain(rows().map(|r| &r.jobs))
+        .flatten()
+        .any(Job::indexes_by_value);
+    in_jobs || rows().any(|r| matches!(&r.cond, Condition::When(e) if e.indexes_by_value()))
 }
 
 /// The condition of a row after one that can index out of range: tried

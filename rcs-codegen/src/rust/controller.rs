@@ -285,13 +285,7 @@ pub(crate) fn module(
     let var_fields = &n.vars;
     let var_tys: Vec<_> = c.vars.iter().map(|v| rust_type(names, &v.ty)).collect();
     let var_docs: Vec<_> = c.vars.iter().map(|v| docs(&v.docs)).collect();
-    let const_gen = Gen {
-        ir,
-        names,
-        ctrl: c,
-        ci,
-        cached: &[],
-    };
+    let const_gen = Gen::new(ir, names, ci);
     let var_defaults_derivable = c
         .vars
         .iter()

@@ -84,3 +84,36 @@ fn a_system_gives_typed_controllers_while_it_holds_their_executive() {
         Some(sm::Status::Executing)
     );
 }
+
+/// Every error a controller can report has a variant of its `Error`: the
+/// two built-ins (`UNKNOWN_COMMAND`, `INDEX_RANGE`) as well as the declared
+/// codes, each going to its runtime code and back and named as in the plans.
+#[test]
+fn built_in_and_declared_errors_round_trip_through_the_typed_error() {
+    use rcs_runtime::ErrorCode;
+    let cases = [
+        (
+            pr::Error::UnknownCommand,
+            ErrorCode::UNKNOWN_COMMAND,
+            "UNKNOWN_COMMAND",
+        ),
+        (pr::Error::IndexRange, ErrorCode::INDEX_RANGE, "INDEX_RANGE"),
+        (
+            pr::Error::TurbineFailed,
+            pr::error::TURBINE_FAILED,
+            "TURBINE_FAILED",
+        ),
+    ];
+    for (typed, raw, name) in cases {
+        assert_eq!(pr::Error::from_raw(raw), Some(typed), "{name}");
+        assert_eq!(typed.raw(), raw, "{name}");
+        assert_eq!(typed.name(), name);
+    }
+    assert_eq!(pr::error::INDEX_RANGE, ErrorCode::INDEX_RANGE);
+    assert_eq!(pr::Error::from_raw(ErrorCode::NONE), None);
+    // The declared codes sit between the two built-ins.
+    assert_eq!(
+        pr::Error::from_raw(ErrorCode(ErrorCode::INDEX_RANGE.0 - 1)),
+        None
+    );
+}

@@ -285,13 +285,7 @@ pub(crate) fn module(
     let var_fields = &n.vars;
     let var_tys: Vec<_> = c.vars.iter().map(|v| rust_type(names, &v.ty)).collect();
     let var_docs: Vec<_> = c.vars.iter().map(|v| docs(&v.docs)).collect();
-    let const_gen = Gen {
-        ir,
-        names,
-        ctrl: c,
-        ci,
-        cached: &[],
-    };
+    let const_gen = Gen::new(ir, names, ci);
     let var_defaults_derivable = c
         .vars
         .iter()
@@ -449,6 +443,8 @@ pub(crate) fn module(
                 pub const NONE: rt::ErrorCode = rt::ErrorCode::NONE;
                 /// A command whose verb has no plan (only from an outside writer).
                 pub const UNKNOWN_COMMAND: rt::ErrorCode = rt::ErrorCode::UNKNOWN_COMMAND;
+                /// An index by a run-time value outside its array (the cycle ended the plan).
+                pub const INDEX_RANGE: rt::ErrorCode = rt::ErrorCode::INDEX_RANGE;
                 #(#error_consts)*
             }
 
@@ -473,11 +469,12 @@ pub(crate) fn module(
 
             /// An error code this controller reports.
             #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-            pub enum Error { UnknownCommand, #(#error_variants),* }
+            pub enum Error { UnknownCommand, IndexRange, #(#error_variants),* }
             impl Error {
                 /// The typed error of a runtime code (`None` for no error).
                 pub const fn from_raw(raw: rt::ErrorCode) -> Option<Self> {
                     if raw.0 == error::UNKNOWN_COMMAND.0 { return Some(Self::UnknownCommand); }
+                    if raw.0 == error::INDEX_RANGE.0 { return Some(Self::IndexRange); }
                     #(if raw.0 == error::#error_consts_ids.0 { return Some(Self::#error_variants); })*
                     None
                 }
@@ -485,6 +482,7 @@ pub(crate) fn module(
                 pub const fn raw(self) -> rt::ErrorCode {
                     match self {
                         Self::UnknownCommand => error::UNKNOWN_COMMAND,
+                        Self::IndexRange => error::INDEX_RANGE,
                         #(Self::#error_variants => error::#error_consts_ids),*
                     }
                 }
@@ -492,6 +490,7 @@ pub(crate) fn module(
                 pub const fn name(self) -> &'static str {
                     match self {
                         Self::UnknownCommand => "UNKNOWN_COMMAND",
+                        Self::IndexRange => "INDEX_RANGE",
                         #(Self::#error_variants => #error_names),*
                     }
                 }

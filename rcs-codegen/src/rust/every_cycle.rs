@@ -68,13 +68,7 @@ pub(crate) fn parts(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments) 
     let c = &ir.controllers[ci];
     let n = &names.ctrls[ci];
     let mut p = Parts::default();
-    let gen = Gen {
-        ir,
-        names,
-        ctrl: c,
-        ci,
-        cached: &[],
-    };
+    let gen = Gen::new(ir, names, ci);
 
     // ---- this controller's status fields
     let own: Vec<(VarId, &Var)> = c.status_fields().collect();

@@ -72,6 +72,20 @@ pub(crate) struct Gen<'a> {
     pub cached: &'a [CachedCall],
 }
 
+impl<'a> Gen<'a> {
+    /// The generator of controller `ci`'s jobs, initialisers and constants:
+    /// no cached hook calls (those belong to a plan's conditions only).
+    pub(crate) fn new(ir: &'a Ir, names: &'a Names, ci: usize) -> Self {
+        Gen {
+            ir,
+            names,
+            ctrl: &ir.controllers[ci],
+            ci,
+            cached: &[],
+        }
+    }
+}
+
 /// A distinct hook call (same hook, syntactically equal arguments) of a
 /// plan's conditions: evaluated at most once per cycle, on first use, into
 /// `local: Option<T>`.

@@ -87,11 +87,19 @@ impl Gen<'_> {
         let (root, mut ty) = self.place_root(place);
         let mut path = root;
         let mut opened = Vec::new();
+        // Right after an `element_mut`, the path is the slot it opened:
+        // `(*slot)` as a whole, plain `slot` before a field (auto-deref,
+        // which clippy wants spelt so).
+        let mut slot_opened: Option<proc_macro2::Ident> = None;
         for proj in &place.path {
+            let base = match slot_opened.take() {
+                Some(slot) if matches!(proj, Projection::Field(_)) => quote!(#slot),
+                _ => path.clone(),
+            };
             match (proj, &ty) {
                 (Projection::Field(f), Type::Buffer(bt)) => {
                     let field = &self.names.buffers[bt.index()].fields[*f as usize];
-                    path = quote!(#path.#field);
+                    path = quote!(#base.#field);
                     ty = self.ir.buffer_types[bt.index()].fields[*f as usize]
                         .ty
                         .clone();
@@ -106,6 +114,7 @@ impl Gen<'_> {
                     let at = &locals[*k as usize];
                     opened.push(quote!(rt::index::element_mut(&mut #path, #at, &mut self.bk)));
                     path = quote!((*#slot));
+                    slot_opened = Some(slot);
                     ty = (**elem).clone();
                 }
                 _ => unreachable!("projections follow the place's type"),
@@ -168,19 +177,17 @@ pub(super) fn cycle_steps(c: &Controller, post: TokenStream) -> (TokenStream, To
     )
 }
 
-/// Whether any expression of the controller indexes by a run-time value.
+/// Whether anything the controller evaluates can index by a run-time
+/// value: an expression, or the place a job assigns (`t.rows[i].x = …`
+/// holds no index expression, yet can meet an index out of range).
 fn indexes_by_value(c: &Controller) -> bool {
-    let mut found = false;
-    let mut see = |e: &Expr| found |= matches!(e.kind, ExprKind::IndexBy(..));
-    for b in c.pre.iter().chain(c.post.iter()) {
-        b.visit_exprs(&mut see);
-    }
-    for p in &c.plans {
-        for r in &p.rows {
-            r.visit_exprs(&mut see);
-        }
-    }
-    found
+    let rows = || c.plans.iter().flat_map(|p| &p.rows);
+    let blocks = c.pre.iter().chain(c.post.iter()).map(|b| &b.jobs);
+    let in_jobs = blocks
+        .chain(rows().map(|r| &r.jobs))
+        .flatten()
+        .any(Job::indexes_by_value);
+    in_jobs || rows().any(|r| matches!(&r.cond, Condition::When(e) if e.indexes_by_value()))
 }
 
 /// The condition of a row after one that can index out of range: tried

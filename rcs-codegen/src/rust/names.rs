@@ -157,12 +157,12 @@ impl Names {
                     error_consts: idents(distinct(
                         c.errors.iter().map(|e| e.name.as_str()),
                         screaming,
-                        &["NONE", "UNKNOWN_COMMAND"],
+                        &["NONE", "UNKNOWN_COMMAND", "INDEX_RANGE"],
                     )),
                     error_variants: idents(distinct(
                         c.errors.iter().map(|e| e.name.as_str()),
                         camel,
-                        &["UnknownCommand"],
+                        &["UnknownCommand", "IndexRange"],
                     )),
                     vars: idents(distinct(c.vars.iter().map(|v| v.name.as_str()), snake, &[])),
                     hooks: idents(distinct(

@@ -84,13 +84,7 @@ pub(super) fn plan_fn(
             quote!(#local: #ty)
         })
         .collect();
-    let gen = Gen {
-        ir,
-        names,
-        ctrl: c,
-        ci,
-        cached: &[],
-    };
+    let gen = Gen::new(ir, names, ci);
     // Each distinct hook call of the conditions runs at most once per
     // cycle, on first use: its result waits in a local for the next row.
     let cached = CachedCall::collect(

@@ -125,37 +125,18 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                         });
                     }
                 }
-                ast::EntryKind::Var { name, ty, .. } => {
+                ast::EntryKind::Var { name, ty, .. }
+                | ast::EntryKind::StatusField { name, ty, .. } => {
+                    let status_field = matches!(e.kind, ast::EntryKind::StatusField { .. });
+                    if status_field {
+                        // A reserved name is reported, and the field still
+                        // declared so that its uses do not cascade.
+                        super::every_cycle::status_field_name_free(name, diags);
+                    }
                     if !claim(name, "name", diags) {
                         continue;
                     }
-                    let ty = resolve_type(g, ty, diags);
-                    vars.push(Var {
-                        name: name.text.to_string(),
-                        docs: docs.clone(),
-                        // Unresolved: keep the var so its uses do not cascade.
-                        ty: ty.unwrap_or(Type::Unit),
-                        init: None,
-                        span: name.span,
-                        status_field: false,
-                    });
-                }
-                ast::EntryKind::StatusField { name, ty, .. } => {
-                    // A reserved name is reported, and the field still
-                    // declared so that its uses do not cascade.
-                    super::every_cycle::status_field_name_free(name, diags);
-                    if !claim(name, "name", diags) {
-                        continue;
-                    }
-                    let ty = resolve_type(g, ty, diags);
-                    vars.push(Var {
-                        name: name.text.to_string(),
-                        docs: docs.clone(),
-                        ty: ty.unwrap_or(Type::Unit),
-                        init: None,
-                        span: name.span,
-                        status_field: true,
-                    });
+                    vars.push(declare_var(g, name, ty, docs, status_field, diags));
                 }
                 ast::EntryKind::Hook { name, params, ret } => {
                     if !claim(name, "name", diags) {
@@ -193,6 +174,27 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
         ctrl.errors = errors;
         ctrl.vars = vars;
         ctrl.hooks = hooks;
+    }
+}
+
+/// A var or status field as pass 1 declares it: its type resolved, its
+/// initialiser left for pass 2 (it may name constants and enum variants).
+fn declare_var(
+    g: &Globals,
+    name: &ast::Name,
+    ty: &ast::TypeExpr,
+    docs: &[String],
+    status_field: bool,
+    diags: &mut Diagnostics,
+) -> Var {
+    Var {
+        name: name.text.to_string(),
+        docs: docs.to_vec(),
+        // Unresolved: keep the var so its uses do not cascade.
+        ty: resolve_type(g, ty, diags).unwrap_or(Type::Unit),
+        init: None,
+        span: name.span,
+        status_field,
     }
 }
 

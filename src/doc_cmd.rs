@@ -49,7 +49,7 @@ index draws one node per cluster (a CPU of the schedule, or a connected
 part of at most 60 controllers of a CPU's hierarchy) with the command links
 between clusters, each cluster has a page drawing its controllers and
 their neighbours, and the controllers and buffers are listed on pages of
-their own (list-controllers.html, list-buffers.html). Every page loads the
+their own (list-controllers.html, list-buffers.html; 250 rows a page). Every page loads the
 search index only when the search box is first used.
 
 The output is the same, byte for byte, for the same plans and inputs.

@@ -5,10 +5,11 @@
 //! a connected part of its hierarchy) with its number of controllers and
 //! the command links between clusters — and each cluster gets a page that
 //! draws its controllers with the neighbours they command or are commanded
-//! by. The controller and buffer tables move to pages of their own.
+//! by. The controller and buffer tables move to pages of their own, of at
+//! most [`LIST_PAGE`] rows each.
 //!
 //! Pages (in the set's folder): `cluster-<name>.html` per cluster,
-//! `list-controllers.html`, `list-buffers.html`. A hyphen cannot occur in
+//! `list-controllers[-N].html`, `list-buffers[-N].html`. A hyphen cannot occur in
 //! a controller's name, so none of them can be a controller's page.
 
 use super::html::{esc, finding, page};
@@ -42,6 +43,24 @@ pub(super) struct Cluster {
     pub cpu: String,
     /// Controller indexes, each supervisor before its subordinates.
     pub members: Vec<usize>,
+}
+
+/// Rows per page of a large set's lists.
+pub const LIST_PAGE: usize = 250;
+
+/// The `k`th page (from 0) of a list whose first page is `first`:
+/// `list-buffers.html`, `list-buffers-2.html`, …
+pub(super) fn list_page(first: &str, k: usize) -> String {
+    if k == 0 {
+        first.to_string()
+    } else {
+        format!("{}-{}.html", first.trim_end_matches(".html"), k + 1)
+    }
+}
+
+/// The page of a large set's buffer list showing buffer `b`.
+pub(super) fn buffer_list_page(b: usize) -> String {
+    list_page(BUFFERS_PAGE, b / LIST_PAGE)
 }
 
 /// The list pages of a large set, in its folder.
@@ -411,17 +430,48 @@ pub(super) fn pages(site: &Site, set: &SetDoc, svgs: &Svgs) -> Vec<crate::Output
             contents: page(&format!("{} · {}", ir.system, cl.title), root, &body),
         });
     }
-    let all: Vec<usize> = (0..ir.controllers.len()).collect();
-    let body = nav("controllers") + &controllers_table(ir, "", &all);
-    files.push(crate::OutputFile {
-        path: format!("{folder}{CONTROLLERS_PAGE}"),
-        contents: page(&format!("{} · controllers", ir.system), root, &body),
-    });
-    let body = nav("buffers") + &buffers_table(ir, "");
-    files.push(crate::OutputFile {
-        path: format!("{folder}{BUFFERS_PAGE}"),
-        contents: page(&format!("{} · buffers", ir.system), root, &body),
-    });
+    let lists = [
+        ("controllers", ir.controllers.len(), CONTROLLERS_PAGE),
+        ("buffers", ir.buffers.len(), BUFFERS_PAGE),
+    ];
+    for (what, count, first) in lists {
+        let all: Vec<usize> = (0..count).collect();
+        let chunks: Vec<&[usize]> = all.chunks(LIST_PAGE).collect();
+        let name = |k: usize| list_page(first, k);
+        for (k, chunk) in chunks.iter().enumerate() {
+            let mut body = nav(what);
+            if chunks.len() > 1 {
+                let links: Vec<String> = (0..chunks.len())
+                    .map(|j| {
+                        let range = format!(
+                            "{}–{}",
+                            j * LIST_PAGE + 1,
+                            (j * LIST_PAGE + LIST_PAGE).min(count)
+                        );
+                        if j == k {
+                            format!("<b>{range}</b>")
+                        } else {
+                            format!("<a href=\"{}\">{range}</a>", name(j))
+                        }
+                    })
+                    .collect();
+                let _ = writeln!(
+                    body,
+                    "<p class=\"pager\">{count} {what}: {}</p>",
+                    links.join(" · ")
+                );
+            }
+            body.push_str(&if what == "controllers" {
+                controllers_table(ir, "", chunk)
+            } else {
+                buffers_table(ir, "", chunk)
+            });
+            files.push(crate::OutputFile {
+                path: format!("{folder}{}", name(k)),
+                contents: page(&format!("{} · {what}", ir.system), root, &body),
+            });
+        }
+    }
     files
 }
 

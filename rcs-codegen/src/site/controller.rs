@@ -113,7 +113,7 @@ pub(super) fn controller_page(site: &Site, set: &SetDoc, ci: usize, placed: &Pla
         (
             format!(
                 "<a href=\"{root}{}#{}\">{}</a>",
-                buffers_href(site, set),
+                buffers_href(site, set, b.index()),
                 esc(&buffer_anchor(ir, &buf.name)),
                 esc(&buf.name)
             ),

@@ -56,7 +56,8 @@ pub(super) fn index_page(site: &Site, svgs: &Svgs, placed: &[Placed]) -> String 
         }
         let all: Vec<usize> = (0..ir.controllers.len()).collect();
         body.push_str(&controllers_table(ir, &folder, &all));
-        body.push_str(&buffers_table(ir, &folder));
+        let buffers: Vec<usize> = (0..ir.buffers.len()).collect();
+        body.push_str(&buffers_table(ir, &folder, &buffers));
         body.push_str("</section>\n");
     }
     page("Plans", "", &body)
@@ -107,13 +108,14 @@ pub(super) fn controllers_table(ir: &Ir, prefix: &str, members: &[usize]) -> Str
     out
 }
 
-/// The table of a set's buffers with the writer and readers of each
-/// (nothing when it has none); `prefix` as for [`controllers_table`].
-pub(super) fn buffers_table(ir: &Ir, prefix: &str) -> String {
+/// The table of the buffers `which` (indexes) with the writer and readers
+/// of each (nothing when there are none); `prefix` as for
+/// [`controllers_table`].
+pub(super) fn buffers_table(ir: &Ir, prefix: &str, which: &[usize]) -> String {
     let mut out = String::new();
-    if !ir.buffers.is_empty() {
+    if !which.is_empty() {
         out.push_str("<h3>Buffers</h3>\n<table>\n<tr><th>buffer</th><th>type</th><th>written by</th><th>read by</th></tr>\n");
-        for b in &ir.buffers {
+        for b in which.iter().filter_map(|b| ir.buffers.get(*b)) {
             let link = |c: rcs_dsl::ir::CtrlId| {
                 let c = ir.controller(c);
                 format!("<a href=\"{prefix}{}\">{}</a>", ctrl_page(c), esc(&c.name))
@@ -172,11 +174,15 @@ pub(super) fn search_js(site: &Site) -> String {
                 }
             }
         }
-        for b in &ir.buffers {
+        for (bi, b) in ir.buffers.iter().enumerate() {
             entries.push((
                 b.name.clone(),
                 "buffer",
-                format!("{}#{}", buffers_href(site, set), buffer_anchor(ir, &b.name)),
+                format!(
+                    "{}#{}",
+                    buffers_href(site, set, bi),
+                    buffer_anchor(ir, &b.name)
+                ),
             ));
         }
     }

@@ -32,7 +32,7 @@ mod plan;
 pub mod runs;
 mod svg;
 
-pub use clusters::{CLUSTER_MAX, LARGE_SET};
+pub use clusters::{CLUSTER_MAX, LARGE_SET, LIST_PAGE};
 pub use runs::RunCounts;
 
 use crate::OutputFile;
@@ -150,11 +150,11 @@ fn cluster_graphs(ir: &Ir, folder: &str) -> Vec<GraphSource> {
     out
 }
 
-/// Where a set's buffers are listed, from the site's root: the index, or
-/// a large set's list of buffers.
-fn buffers_href(site: &Site, set: &SetDoc) -> String {
+/// Where a set's buffer `b` (index) is listed, from the site's root: the
+/// index, or the page of a large set's list of buffers that shows it.
+fn buffers_href(site: &Site, set: &SetDoc, b: usize) -> String {
     if clusters::is_large(set.ir) {
-        format!("{}{}", folder(site, set), clusters::BUFFERS_PAGE)
+        format!("{}{}", folder(site, set), clusters::buffer_list_page(b))
     } else {
         "index.html".into()
     }

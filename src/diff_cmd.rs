@@ -122,6 +122,27 @@ fn run(args: &DiffArgs) -> Result<ExitCode, String> {
     })
 }
 
+/// The older side of `rcsc doc --diff OLD`, read as `rcsc diff OLD` reads
+/// it: a path, or a revision (its `paths`, extracted into a temporary
+/// folder that lives as long as the value).
+pub(crate) struct OldSide {
+    pub(crate) sets: Vec<rcs_dsl::PlanSet>,
+    /// `OLD` as named.
+    pub(crate) name: String,
+    _temps: Vec<TempDir>,
+}
+
+pub(crate) fn old_side(old: &str, paths: &[PathBuf]) -> Result<OldSide, String> {
+    let old = side(old)?;
+    let mut temps = Vec::new();
+    let sets = load(&old, paths, &mut temps)?;
+    Ok(OldSide {
+        sets,
+        name: old.name(),
+        _temps: temps,
+    })
+}
+
 /// The two sides from `OLD [NEW]`: `A..B` names two revisions; a lone
 /// side is compared with the working tree.
 fn sides(old: &str, new: Option<&str>, paths: &[PathBuf]) -> Result<(Where, Where), String> {

@@ -10,7 +10,7 @@
 use crate::args::Common;
 use crate::commands::{check_sets_each, render_svg};
 use crate::output::*;
-use crate::{test_cmd, trace_cmd};
+use crate::{diff_cmd, test_cmd, trace_cmd};
 use rcs_codegen::site::{self, GraphSource, RunCounts, SetDoc, Site, Svgs};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -35,13 +35,32 @@ site is written with a notice in place of each drawing, and a warning.
 cycles fired it, edges are drawn heavier the more they fired, rows that
 never fired are marked, and each state shows the cycles spent in it.
 
+--diff OLD adds a Changes page (diff-changes.html) comparing the plans with
+OLD, a git revision of the current repository or a path, as `rcsc diff OLD`
+does: per changed plan its diff-coloured state graph (rows added green,
+removed red and dashed, changed orange, moved in precedence marked ⇅), its
+changed rows, states and moves, and a link to its page; the declarations
+changed; the findings the change introduced or removed. The index links to
+it, and each changed controller and plan shows a “changed in this diff”
+badge linking to its part of it.
+
+Sets of more than 60 controllers are documented cluster by cluster: the
+index draws one node per cluster (a CPU of the schedule, or a connected
+part of at most 60 controllers of a CPU's hierarchy) with the command links
+between clusters, each cluster has a page drawing its controllers and
+their neighbours, and the controllers and buffers are listed on pages of
+their own (list-controllers.html, list-buffers.html; 250 rows a page). Every page loads the
+search index only when the search box is first used.
+
 The output is the same, byte for byte, for the same plans and inputs.
 Generated files of an earlier run that are no longer produced are removed.
 
 Examples:
   rcsc doc plans/ -o target/doc --open
   rcsc doc plans/submarine --coverage
-  rcsc doc plans/submarine --trace run.jsonl";
+  rcsc doc plans/submarine --trace run.jsonl
+  rcsc doc plans/ --diff HEAD~1
+  rcsc doc plans/submarine --diff old/submarine";
 
 #[derive(clap::Args)]
 pub(crate) struct DocArgs {
@@ -64,6 +83,9 @@ pub(crate) struct DocArgs {
     /// Show the row hits of these traces (JSON lines).
     #[arg(long, value_name = "FILE", num_args = 1..)]
     pub(crate) trace: Vec<PathBuf>,
+    /// Add a Changes page against OLD: a git revision or a path.
+    #[arg(long, value_name = "OLD")]
+    pub(crate) diff: Option<String>,
     #[command(flatten)]
     pub(crate) common: Common,
 }
@@ -74,7 +96,8 @@ pub(crate) fn doc(args: DocArgs) -> ExitCode {
         color: args.common.color(),
         quiet: args.common.quiet,
     };
-    let sets = match rcs_dsl::load_paths(&default_paths(args.paths)) {
+    let paths = default_paths(args.paths);
+    let sets = match rcs_dsl::load_paths(&paths) {
         Ok(sets) => sets,
         Err(e) => return fail(e),
     };
@@ -97,7 +120,28 @@ pub(crate) fn doc(args: DocArgs) -> ExitCode {
     } else {
         Vec::new()
     };
+    // Read before the site is built, so a bad OLD fails early; kept (with
+    // its temporary folder) until the diff is made.
+    let old = match &args.diff {
+        Some(old) => match diff_cmd::old_side(old, &paths) {
+            Ok(o) => Some(o),
+            Err(reason) => return fail(reason),
+        },
+        None => None,
+    };
+    let changes = match &old {
+        Some(old) => match diff_against(old, &irs, &findings, &args.common) {
+            Ok(d) => Some(d),
+            Err(reason) => return fail(reason),
+        },
+        None => None,
+    };
+    drop(old);
     let site = Site {
+        changes: changes.as_ref().map(|(diff, against)| site::Changes {
+            diff,
+            against: against.clone(),
+        }),
         shared: rcs_dsl::load::shares_output(&sets),
         sets: sets
             .iter()
@@ -156,6 +200,42 @@ pub(crate) fn doc(args: DocArgs) -> ExitCode {
         open(&index);
     }
     ExitCode::SUCCESS
+}
+
+/// The diff of the documented plans against the old side, checked as
+/// `rcsc diff` checks it, and the old side's name.
+fn diff_against(
+    old: &diff_cmd::OldSide,
+    irs: &[rcs_dsl::ir::Ir],
+    findings: &[Vec<rcs_dsl::Diagnostic>],
+    common: &Common,
+) -> Result<(rcs_dsl::diff::PlanSetDiff, String), String> {
+    let options = common.options();
+    let mut checked = Vec::new();
+    for set in &old.sets {
+        match rcs_dsl::diff::check_side(set, &options) {
+            (Some(ir), diags) => checked.push((ir, diags)),
+            (None, _) => {
+                return Err(format!(
+                    "{} does not parse; nothing to compare (`rcsc diff {}` shows why)",
+                    old.name, old.name
+                ))
+            }
+        }
+    }
+    let old_sides: Vec<rcs_dsl::diff::Side> = checked
+        .iter()
+        .map(|(ir, diagnostics)| rcs_dsl::diff::Side { ir, diagnostics })
+        .collect();
+    let new_sides: Vec<rcs_dsl::diff::Side> = irs
+        .iter()
+        .zip(findings)
+        .map(|(ir, diagnostics)| rcs_dsl::diff::Side { ir, diagnostics })
+        .collect();
+    Ok((
+        rcs_dsl::diff::diff(&old_sides, &new_sides),
+        old.name.clone(),
+    ))
 }
 
 /// Whether Graphviz `dot` can be run.

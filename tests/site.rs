@@ -1,10 +1,13 @@
 //! `rcsc doc`, `rcsc trace` and traces, end to end: the pages of a small
 //! plan set (snapshots of the pure generation), every link of the site
 //! for `plans/` resolving, byte-identical output, the site without
-//! Graphviz, trace versions, and a run of the submarine example replayed
-//! through `rcsc trace`.
+//! Graphviz, trace versions, a run of the submarine example replayed
+//! through `rcsc trace`, a large set documented cluster by cluster, and
+//! the Changes page of `rcsc doc --diff` (fixture: `tests/data/site/`).
 
 mod common;
+#[path = "../rcs-dsl/benches/common/plan_set.rs"]
+mod plan_set;
 
 use common::site_links::broken_links;
 use common::{rcsc, scratch, text, tree};
@@ -69,6 +72,7 @@ fn small_site_files(with_runs: bool) -> BTreeMap<String, String> {
     runs.add_state("A", 0, 1, 7);
     let s = Site {
         shared: false,
+        changes: None,
         sets: vec![SetDoc {
             ir: &ir,
             sources: set.sources.files().map(|(_, f)| f.text.as_str()).collect(),
@@ -308,4 +312,139 @@ fn a_submarine_run_replays_through_rcsc_trace() {
     counted.retain(|_, n| *n > 0);
     assert_eq!(counted, expected, "{summary}\n{printed}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `rcsc doc --diff`: the fixture's new door against its old one (paths;
+/// a revision is read the same way as `rcsc diff` reads it). Which pages
+/// exist, which links, which colours the diff graph draws.
+#[test]
+fn doc_diff_adds_a_changes_page_linked_from_what_changed() {
+    let dir = scratch("doc-diff", &[]);
+    let out = dir.join("site");
+    let o = rcsc(&[
+        "doc",
+        "tests/data/site/new/door",
+        "--diff",
+        "tests/data/site/old/door",
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let files = site_of(&out);
+    assert_eq!(broken_links(&files), Vec::<String>::new());
+    let changes = &files["diff-changes.html"];
+    // The index and the changed controller and plan link to their part of
+    // the page; the unchanged plan does not.
+    assert!(files["index.html"].contains("<a href=\"diff-changes.html\">Changes against tests/data/site/old/door</a>: 1 plan changed."));
+    assert!(files["DOOR.html"].contains("href=\"diff-changes.html#ctrl-door.DOOR\""));
+    assert!(files["DOOR.OPEN.html"]
+        .contains("href=\"diff-changes.html#plan-door.DOOR.OPEN\">changed in this diff"));
+    assert!(!files["DOOR.CLOSE.html"].contains("changed in this diff"));
+    // One changed plan, linked to its page, drawn and tabled.
+    assert_eq!(changes.matches("class=\"changed-plan\"").count(), 1);
+    assert!(changes.contains("<h4>Plan <a href=\"DOOR.OPEN.html\">DOOR.OPEN</a></h4>"));
+    assert!(!changes.contains("DOOR.CLOSE"));
+    assert!(changes.contains("<li class=\"added\">state <code>S2</code> added</li>"));
+    for class in ["renumbered", "changed", "added"] {
+        assert!(
+            changes.contains(&format!("<tr class=\"{class}\">")),
+            "{class}"
+        );
+    }
+    assert!(changes.contains("<p class=\"moved\"><b>⇅ Moved in precedence</b></p>"));
+    // The graph as `diff_dot` colours it: added green, changed orange,
+    // the row moved marked.
+    let svg = &changes[changes.find("<svg").unwrap()..changes.find("</svg>").unwrap()];
+    for colour in ["stroke=\"darkgreen\"", "stroke=\"darkorange\""] {
+        assert!(svg.contains(colour), "{colour}");
+    }
+    assert!(svg.contains("⇅"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn doc_diff_against_what_is_neither_a_path_nor_a_revision_fails() {
+    let dir = scratch("doc-diff-bad", &[]);
+    let o = rcsc(&[
+        "doc",
+        "tests/data/site/new/door",
+        "--diff",
+        "no-such-revision-or-path",
+        "-o",
+        dir.join("site").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
+    assert!(text(&o.stderr).contains("neither a file or folder nor a git revision"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A set above `LARGE_SET`: the index draws clusters (no controller of the
+/// whole hierarchy), each cluster has a page with its controllers, the
+/// lists have pages of at most `LIST_PAGE` rows, the search index sends buffers to their list; no page
+/// loads the search index itself; every link resolves.
+#[test]
+fn a_large_set_is_documented_cluster_by_cluster() {
+    let n = site::LIST_PAGE + 7;
+    let texts = plan_set::plan_set(n);
+    let set = rcs_dsl::PlanSet::from_texts(
+        "large",
+        texts.iter().map(|(p, t)| (p.as_str(), t.as_str())),
+        None,
+    );
+    let checked = rcs_dsl::check(&set, &rcs_dsl::Options::default());
+    let ir = checked.ir.expect("the generated set checks");
+    let s = Site {
+        shared: false,
+        changes: None,
+        sets: vec![SetDoc {
+            ir: &ir,
+            sources: set.sources.files().map(|(_, f)| f.text.as_str()).collect(),
+            findings: &checked.diagnostics,
+            runs: None,
+        }],
+    };
+    let graphs = site::graphs(&s);
+    assert!(!graphs.iter().any(|g| g.key == "hierarchy"));
+    let svgs: Svgs = graphs
+        .iter()
+        .map(|g| (g.key.clone(), fake_svg(&g.dot)))
+        .collect();
+    let files: BTreeMap<String, String> = site::pages(&s, &svgs)
+        .into_iter()
+        .map(|f| (f.path, f.contents))
+        .collect();
+    assert_eq!(broken_links(&files), Vec::<String>::new());
+    let index = &files["index.html"];
+    assert!(
+        !index.contains("id=\"ctrl-"),
+        "the whole hierarchy is drawn"
+    );
+    let clusters: Vec<&String> = files.keys().filter(|p| p.starts_with("cluster-")).collect();
+    assert!(clusters.len() >= 3, "{clusters:?}");
+    // Each controller is drawn (as a member) in exactly one cluster.
+    let mut drawn = 0;
+    for c in &clusters {
+        assert!(index.contains(&format!("href=\"{c}\"")), "{c}");
+        drawn += files[*c].matches("<g id=\"ctrl-").count();
+    }
+    assert_eq!(drawn, n);
+    // The lists are paged: 250 rows, then the 7 left.
+    let rows = |page: &str| files[page].matches("<tr><td><a href=").count();
+    assert_eq!(rows("list-controllers.html"), site::LIST_PAGE);
+    assert_eq!(rows("list-controllers-2.html"), 7);
+    assert!(files["list-controllers.html"].contains("<a href=\"list-controllers-2.html\">"));
+    // A buffer link leads to the page of the list that shows it (the
+    // crawler above checks the anchor is there).
+    assert!(files.contains_key("list-buffers-3.html"));
+    let page = files["C252.html"]
+        .split("href=\"")
+        .find(|l| l.contains("#b-large.d252\""))
+        .unwrap();
+    assert!(page.starts_with("list-buffers-"), "{page}");
+    assert!(files["search.js"].contains("\"list-buffers.html#b-large.d0\""));
+    assert!(files["C1.html"].contains("href=\"list-buffers.html#b-large.d1\""));
+    assert!(files
+        .iter()
+        .all(|(p, t)| !p.ends_with(".html") || !t.contains("search.js")));
 }

@@ -5,12 +5,17 @@
 //! targets, highlighted); follow the row back to its edge and source line;
 //! keep a screenshot of every page under `target/site-screenshots/`; no
 //! page may log a console error; every link of every page resolves.
+//! Also a generated set just above `LARGE_SET` (index → a cluster → a
+//! controller; the search index loaded only when used) and the Changes
+//! page of `rcsc doc --diff` (a changed plan's badge → its changes → back).
 //!
 //! Chromium and chromedriver come from Debian's `chromium` and
 //! `chromium-driver` packages (`.ci/run` installs them). Without them the
 //! test fails and says how to install them, unless `RCSC_SKIP_BROWSER=1`.
 
 mod common;
+#[path = "../rcs-dsl/benches/common/plan_set.rs"]
+mod plan_set;
 
 use common::site_links::broken_links;
 use common::{rcsc, scratch, text, tree};
@@ -120,8 +125,9 @@ fn file_url(path: &Path) -> String {
     )
 }
 
-#[tokio::test(flavor = "current_thread")]
-async fn the_site_in_chromium() {
+/// Chromium and chromedriver, or `None` (after saying so) when they are
+/// missing and `RCSC_SKIP_BROWSER=1`.
+fn browser() -> Option<(PathBuf, PathBuf)> {
     let chromium = on_path(&["chromium", "chromium-browser", "google-chrome"]);
     let chromedriver = on_path(&["chromedriver"]);
     let (Some(chromium), Some(chromedriver)) = (chromium, chromedriver) else {
@@ -129,7 +135,7 @@ async fn the_site_in_chromium() {
             eprintln!(
                 "note: RCSC_SKIP_BROWSER=1 and Chromium is missing: the browser test did not run"
             );
-            return;
+            return None;
         }
         panic!(
             "the browser test needs Chromium and chromedriver: install them with \
@@ -137,24 +143,13 @@ async fn the_site_in_chromium() {
              RCSC_SKIP_BROWSER=1 to skip this test"
         );
     };
+    Some((chromium, chromedriver))
+}
 
-    let dir = scratch("browser", &[]);
-    let site = dir.join("site");
-    let o = rcsc(&["doc", "plans", "-o", site.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    let files: std::collections::BTreeMap<String, String> = tree(&site)
-        .into_iter()
-        .map(|(p, b)| (p, String::from_utf8(b).unwrap()))
-        .collect();
-    assert_eq!(broken_links(&files), Vec::<String>::new());
-
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("target"));
-    let shots = target.join("site-screenshots");
-    std::fs::create_dir_all(&shots).unwrap();
-
-    let (_driver, port) = start_driver(&chromedriver);
+/// A WebDriver session with headless Chromium (and its driver, which must
+/// outlive it).
+async fn session(chromium: &Path, chromedriver: &Path) -> (Driver, Client) {
+    let (driver, port) = start_driver(chromedriver);
     let caps = serde_json::json!({
         "browserName": "chrome",
         "goog:chromeOptions": {
@@ -172,6 +167,70 @@ async fn the_site_in_chromium() {
         .connect(&format!("http://127.0.0.1:{port}/"))
         .await
         .expect("a WebDriver session");
+    (driver, c)
+}
+
+/// Where the screenshots go: `target/site-screenshots/<name>/`.
+fn screenshots(name: &str) -> PathBuf {
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("target"));
+    let shots = target.join("site-screenshots").join(name);
+    std::fs::create_dir_all(&shots).unwrap();
+    shots
+}
+
+/// `rcsc doc` of `plans` (and `extra` arguments) into `site`; its files as
+/// text, every link checked.
+fn build_site(
+    plans: &Path,
+    extra: &[&str],
+    site: &Path,
+) -> std::collections::BTreeMap<String, String> {
+    let mut args = vec!["doc", plans.to_str().unwrap(), "-o", site.to_str().unwrap()];
+    args.extend(extra);
+    let o = rcsc(&args);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let files: std::collections::BTreeMap<String, String> = tree(site)
+        .into_iter()
+        .map(|(p, b)| (p, String::from_utf8(b).unwrap()))
+        .collect();
+    assert_eq!(broken_links(&files), Vec::<String>::new());
+    files
+}
+
+/// Visit every page: a screenshot of each, and the console errors.
+async fn visit_all(
+    c: &Client,
+    site: &Path,
+    files: &std::collections::BTreeMap<String, String>,
+    shots: &Path,
+) -> Vec<String> {
+    let mut errors = Vec::new();
+    for path in files.keys().filter(|p| p.ends_with(".html")) {
+        c.goto(&file_url(&site.join(path))).await.unwrap();
+        let name = path.replace('/', "__");
+        screenshot(c, shots, name.trim_end_matches(".html")).await;
+        errors.extend(
+            console_errors(c)
+                .await
+                .into_iter()
+                .map(|e| format!("{path}: {e}")),
+        );
+    }
+    errors
+}
+
+#[tokio::test(flavor = "current_thread")]
+async fn the_site_in_chromium() {
+    let Some((chromium, chromedriver)) = browser() else {
+        return;
+    };
+    let dir = scratch("browser", &[]);
+    let site = dir.join("site");
+    let files = build_site(Path::new("plans"), &[], &site);
+    let shots = screenshots("plans");
+    let (_driver, c) = session(&chromium, &chromedriver).await;
 
     // Index → the hierarchy's PR node.
     c.goto(&file_url(&site.join("index.html"))).await.unwrap();
@@ -258,18 +317,190 @@ async fn the_site_in_chromium() {
     let mut errors = console_errors(&c).await;
 
     // Every page: a screenshot, and no console error.
-    for path in files.keys().filter(|p| p.ends_with(".html")) {
-        c.goto(&file_url(&site.join(path))).await.unwrap();
-        let name = path.replace('/', "__");
-        screenshot(&c, &shots, name.trim_end_matches(".html")).await;
-        errors.extend(
-            console_errors(&c)
-                .await
-                .into_iter()
-                .map(|e| format!("{path}: {e}")),
-        );
-    }
+    errors.extend(visit_all(&c, &site, &files, &shots).await);
     c.close().await.unwrap();
     assert_eq!(errors, Vec::<String>::new(), "console errors");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The `check` benchmark's generated set of `n` controllers, written to
+/// `dir` (a plan set folder without a manifest: one CPU runs them all).
+fn write_set(dir: &Path, n: usize) {
+    std::fs::create_dir_all(dir).unwrap();
+    for (path, text) in plan_set::plan_set(n) {
+        std::fs::write(dir.join(path), text).unwrap();
+    }
+}
+
+/// The first element `css` finds, clicked.
+async fn click(c: &Client, css: &str) {
+    c.find(Locator::Css(css))
+        .await
+        .unwrap_or_else(|e| panic!("no `{css}`: {e}"))
+        .click()
+        .await
+        .unwrap();
+}
+
+/// A set just above `rcs_codegen::site::LARGE_SET`: the index draws
+/// clusters; a cluster leads to its controllers, a controller to its page;
+/// the lists have pages; the search (loaded when first used) still finds.
+#[tokio::test(flavor = "current_thread")]
+async fn a_large_set_in_chromium() {
+    let Some((chromium, chromedriver)) = browser() else {
+        return;
+    };
+    let n = rcs_codegen::site::LARGE_SET + 20;
+    let dir = scratch("browser-large", &[]);
+    let plans = dir.join("large");
+    write_set(&plans, n);
+    let site = dir.join("site");
+    let files = build_site(&plans, &[], &site);
+    assert!(
+        !files["index.html"].contains("id=\"ctrl-C0\""),
+        "the whole hierarchy is drawn"
+    );
+    assert!(files.contains_key("list-controllers.html"));
+    assert!(files.contains_key("list-buffers.html"));
+    let shots = screenshots("large");
+    let (_driver, c) = session(&chromium, &chromedriver).await;
+
+    c.goto(&file_url(&site.join("index.html"))).await.unwrap();
+    screenshot(&c, &shots, "index").await;
+    click(&c, "g.node[id^='cluster-'] a text").await;
+    let url = c.current_url().await.unwrap();
+    let cluster = url.path().rsplit('/').next().unwrap().to_string();
+    assert!(cluster.starts_with("cluster-"), "{url}");
+    screenshot(&c, &shots, "cluster").await;
+    let first = c
+        .find(Locator::Css("g.node[id^='ctrl-']"))
+        .await
+        .expect("a controller in the cluster")
+        .attr("id")
+        .await
+        .unwrap()
+        .expect("an id");
+    let name = first.trim_start_matches("ctrl-").to_string();
+    click(&c, &format!("g#{first} a text")).await;
+    let url = c.current_url().await.unwrap();
+    assert!(url.path().ends_with(&format!("/{name}.html")), "{url}");
+    let h1 = c
+        .find(Locator::Css("h1"))
+        .await
+        .unwrap()
+        .text()
+        .await
+        .unwrap();
+    assert_eq!(h1, name);
+
+    // The search index is not loaded until the box is used.
+    let loaded = c
+        .execute("return window.RCS_SEARCH !== undefined;", vec![])
+        .await
+        .unwrap();
+    assert_eq!(loaded, serde_json::Value::Bool(false));
+    c.find(Locator::Id("search"))
+        .await
+        .unwrap()
+        .send_keys("C7.OP3")
+        .await
+        .unwrap();
+    click(&c, "#results a").await;
+    let url = c.current_url().await.unwrap();
+    assert!(url.path().ends_with("/C7.OP3.html"), "{url}");
+    let mut errors = console_errors(&c).await;
+
+    // The pages the large set adds, and one controller's: plan pages are
+    // as in the small set (every link of every page is checked above).
+    let some: std::collections::BTreeMap<String, String> = files
+        .iter()
+        .filter(|(p, _)| !p.starts_with('C') || p.starts_with("C0."))
+        .map(|(p, t)| (p.clone(), t.clone()))
+        .collect();
+    errors.extend(visit_all(&c, &site, &some, &shots).await);
+    c.close().await.unwrap();
+    assert_eq!(errors, Vec::<String>::new(), "console errors");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `rcsc doc --diff`: a changed plan's badge leads to its part of the
+/// Changes page, and that back to the plan's page.
+#[tokio::test(flavor = "current_thread")]
+async fn the_changes_page_in_chromium() {
+    let Some((chromium, chromedriver)) = browser() else {
+        return;
+    };
+    let dir = scratch("browser-diff", &[]);
+    let site = dir.join("site");
+    let files = build_site(
+        Path::new("tests/data/site/new/door"),
+        &["--diff", "tests/data/site/old/door"],
+        &site,
+    );
+    let shots = screenshots("diff");
+    let (_driver, c) = session(&chromium, &chromedriver).await;
+    c.goto(&file_url(&site.join("DOOR.OPEN.html")))
+        .await
+        .unwrap();
+    click(&c, "p.badge a").await;
+    let url = c.current_url().await.unwrap();
+    assert!(url.path().ends_with("/diff-changes.html"), "{url}");
+    assert_eq!(targeted(&c).await.as_deref(), Some("plan-door.DOOR.OPEN"));
+    screenshot(&c, &shots, "changes").await;
+    click(&c, "div#plan-door\\.DOOR\\.OPEN h4 a").await;
+    let url = c.current_url().await.unwrap();
+    assert!(url.path().ends_with("/DOOR.OPEN.html"), "{url}");
+    let mut errors = console_errors(&c).await;
+    errors.extend(visit_all(&c, &site, &files, &shots).await);
+    c.close().await.unwrap();
+    assert_eq!(errors, Vec::<String>::new(), "console errors");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// For BENCHMARKS.md, not a check: writes the generated set of
+/// `RCSC_SET_N` (default 1,000) controllers to `RCSC_SET_DIR`.
+#[test]
+#[ignore = "writes the benchmark's plan set; run by hand"]
+fn write_the_benchmark_set() {
+    let dir = std::env::var_os("RCSC_SET_DIR").expect("RCSC_SET_DIR");
+    let n = std::env::var("RCSC_SET_N")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(1000);
+    write_set(Path::new(&dir), n);
+}
+
+/// For BENCHMARKS.md, not a check (it asserts nothing about time): each
+/// page of `RCSC_SITE_PAGES` (comma-separated, from the site
+/// `RCSC_SITE_DIR`) loaded three times in headless Chromium, printing
+/// `performance.timing`'s navigation start → load event end.
+#[tokio::test(flavor = "current_thread")]
+#[ignore = "measures page loads of a site built by hand; run by hand"]
+async fn page_load_times() {
+    let Some((chromium, chromedriver)) = browser() else {
+        return;
+    };
+    let site = PathBuf::from(std::env::var_os("RCSC_SITE_DIR").expect("RCSC_SITE_DIR"));
+    let pages = std::env::var("RCSC_SITE_PAGES").unwrap_or_else(|_| "index.html".into());
+    let (_driver, c) = session(&chromium, &chromedriver).await;
+    for page in pages.split(',') {
+        let mut times = Vec::new();
+        for _ in 0..3 {
+            c.goto("about:blank").await.unwrap();
+            c.goto(&file_url(&site.join(page))).await.unwrap();
+            let ms = c
+                .execute(
+                    "const t = performance.timing; return t.loadEventEnd - t.navigationStart;",
+                    vec![],
+                )
+                .await
+                .unwrap();
+            times.push(ms.to_string());
+        }
+        let bytes = std::fs::metadata(site.join(page))
+            .map(|m| m.len())
+            .unwrap_or(0);
+        println!("{page}: {} ms ({bytes} bytes)", times.join(" / "));
+    }
+    c.close().await.unwrap();
 }

@@ -6,7 +6,7 @@
 use super::html::{docs, esc, finding, page};
 use super::index::buffer_anchor;
 use super::plan::Placed;
-use super::{ctrl_page, plan_page, root_of, SetDoc, Site};
+use super::{buffers_href, ctrl_page, plan_page, root_of, SetDoc, Site};
 use rcs_dsl::ir::{BufferId, CtrlId};
 use std::fmt::Write;
 
@@ -23,6 +23,7 @@ pub(super) fn controller_page(site: &Site, set: &SetDoc, ci: usize, placed: &Pla
         esc(&ir.system),
         esc(&c.name)
     );
+    body.push_str(&super::changes::controller_badge(site, set, c, root));
     if let Some(t) = &c.title {
         let _ = writeln!(body, "<p class=\"title\">{}</p>", esc(t));
     }
@@ -111,7 +112,8 @@ pub(super) fn controller_page(site: &Site, set: &SetDoc, ci: usize, placed: &Pla
             .unwrap_or_default();
         (
             format!(
-                "<a href=\"{root}index.html#{}\">{}</a>",
+                "<a href=\"{root}{}#{}\">{}</a>",
+                buffers_href(site, set, b.index()),
                 esc(&buffer_anchor(ir, &buf.name)),
                 esc(&buf.name)
             ),

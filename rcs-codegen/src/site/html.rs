@@ -17,7 +17,7 @@ pub(super) fn page(title: &str, root: &str, body: &str) -> String {
         "<!-- {GENERATED}. Do not edit. -->\n<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n\
          <meta charset=\"utf-8\">\n<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
          <title>{title}</title>\n<link rel=\"stylesheet\" href=\"{root}site.css\">\n\
-         <script src=\"{root}search.js\" defer></script>\n<script src=\"{root}site.js\" defer></script>\n\
+         <script src=\"{root}site.js\" defer></script>\n\
          </head>\n<body data-root=\"{root}\">\n<header>\n<a class=\"home\" href=\"{root}index.html\">rcsc doc</a>\n\
          <input id=\"search\" type=\"search\" placeholder=\"Search controllers, verbs, buffers, states\" autocomplete=\"off\" aria-label=\"Search\">\n\
          <ul id=\"results\" hidden></ul>\n</header>\n<main>\n<h1>{title}</h1>\n{body}</main>\n</body>\n</html>\n"

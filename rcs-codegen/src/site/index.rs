@@ -1,10 +1,11 @@
 //! The site's root: `index.html` (per plan set its hierarchy graph, its
-//! controllers and its buffers, each buffer with its writer and readers)
-//! and `search.js`, the search index every page loads.
+//! controllers and its buffers, each buffer with its writer and readers;
+//! for a large set the clusters of [`super::clusters`] instead) and
+//! `search.js`, the search index pages load when the search box is used.
 
 use super::html::{esc, finding, page};
 use super::plan::Placed;
-use super::{ctrl_page, folder, hierarchy_key, plan_page, svg, Site, Svgs};
+use super::{buffers_href, clusters, ctrl_page, folder, hierarchy_key, plan_page, svg, Site, Svgs};
 use rcs_dsl::ir::Ir;
 use std::fmt::Write;
 
@@ -26,6 +27,9 @@ pub(super) fn graph_or_notice(svg: Option<&String>, what: &str) -> String {
 
 pub(super) fn index_page(site: &Site, svgs: &Svgs, placed: &[Placed]) -> String {
     let mut body = String::new();
+    if let Some(c) = &site.changes {
+        body.push_str(&super::changes::index_banner(c));
+    }
     for (set, placed) in site.sets.iter().zip(placed) {
         let ir = set.ir;
         let folder = folder(site, set);
@@ -38,6 +42,11 @@ pub(super) fn index_page(site: &Site, svgs: &Svgs, placed: &[Placed]) -> String 
                 esc(&r.source)
             );
         }
+        if clusters::is_large(ir) {
+            body.push_str(&clusters::index_section(site, set, svgs, placed));
+            body.push_str("</section>\n");
+            continue;
+        }
         body.push_str(&graph_or_notice(
             svgs.get(&hierarchy_key(&folder)),
             &format!("the {} hierarchy", ir.system),
@@ -45,69 +54,89 @@ pub(super) fn index_page(site: &Site, svgs: &Svgs, placed: &[Placed]) -> String 
         for d in &placed.set {
             body.push_str(&finding(d));
         }
-        body.push_str("<h3>Controllers</h3>\n<table>\n<tr><th>controller</th><th>title</th><th>CPU</th><th>supervisor</th><th>plans</th></tr>\n");
-        for (ci, c) in ir.controllers.iter().enumerate() {
-            let cpu = ir
-                .schedule
-                .iter()
-                .find(|cpu| cpu.order.iter().any(|o| o.index() == ci))
-                .map(|cpu| cpu.name.as_str())
-                .unwrap_or("—");
-            let sup = match c.supervisor {
-                Some(s) => {
-                    let s = ir.controller(s);
-                    format!("<a href=\"{folder}{}\">{}</a>", ctrl_page(s), esc(&s.name))
-                }
-                None => "the operator".into(),
-            };
-            let plans: Vec<String> = c
-                .plans
-                .iter()
-                .map(|p| {
-                    format!(
-                        "<a href=\"{folder}{}\">{}</a>",
-                        plan_page(c, p),
-                        esc(&c.commands[p.verb.index()].name)
-                    )
-                })
-                .collect();
-            let _ = writeln!(
-                body,
-                "<tr><td><a href=\"{folder}{}\">{}</a></td><td>{}</td><td>{}</td><td>{sup}</td><td>{}</td></tr>",
-                ctrl_page(c),
-                esc(&c.name),
-                esc(c.title.as_deref().unwrap_or("")),
-                esc(cpu),
-                plans.join(" ")
-            );
-        }
-        body.push_str("</table>\n");
-        if !ir.buffers.is_empty() {
-            body.push_str("<h3>Buffers</h3>\n<table>\n<tr><th>buffer</th><th>type</th><th>written by</th><th>read by</th></tr>\n");
-            for b in &ir.buffers {
-                let link = |c: rcs_dsl::ir::CtrlId| {
-                    let c = ir.controller(c);
-                    format!("<a href=\"{folder}{}\">{}</a>", ctrl_page(c), esc(&c.name))
-                };
-                let writer = b
-                    .writer
-                    .map(link)
-                    .unwrap_or_else(|| "an external input".into());
-                let readers: Vec<String> = b.readers.iter().map(|r| link(*r)).collect();
-                let _ = writeln!(
-                    body,
-                    "<tr id=\"{}\"><td>{}</td><td>{}</td><td>{writer}</td><td>{}</td></tr>",
-                    esc(&buffer_anchor(ir, &b.name)),
-                    esc(&b.name),
-                    esc(&ir.buffer_types[b.ty.index()].name),
-                    readers.join(", ")
-                );
-            }
-            body.push_str("</table>\n");
-        }
+        let all: Vec<usize> = (0..ir.controllers.len()).collect();
+        body.push_str(&controllers_table(ir, &folder, &all));
+        let buffers: Vec<usize> = (0..ir.buffers.len()).collect();
+        body.push_str(&buffers_table(ir, &folder, &buffers));
         body.push_str("</section>\n");
     }
     page("Plans", "", &body)
+}
+
+/// The table of the controllers `members` (indexes), linking to their
+/// pages through `prefix` (the set's folder, from the page).
+pub(super) fn controllers_table(ir: &Ir, prefix: &str, members: &[usize]) -> String {
+    let mut out = String::new();
+    out.push_str("<h3>Controllers</h3>\n<table>\n<tr><th>controller</th><th>title</th><th>CPU</th><th>supervisor</th><th>plans</th></tr>\n");
+    for &ci in members {
+        let c = &ir.controllers[ci];
+        let cpu = ir
+            .schedule
+            .iter()
+            .find(|cpu| cpu.order.iter().any(|o| o.index() == ci))
+            .map(|cpu| cpu.name.as_str())
+            .unwrap_or("—");
+        let sup = match c.supervisor {
+            Some(s) => {
+                let s = ir.controller(s);
+                format!("<a href=\"{prefix}{}\">{}</a>", ctrl_page(s), esc(&s.name))
+            }
+            None => "the operator".into(),
+        };
+        let plans: Vec<String> = c
+            .plans
+            .iter()
+            .map(|p| {
+                format!(
+                    "<a href=\"{prefix}{}\">{}</a>",
+                    plan_page(c, p),
+                    esc(&c.commands[p.verb.index()].name)
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            out,
+            "<tr><td><a href=\"{prefix}{}\">{}</a></td><td>{}</td><td>{}</td><td>{sup}</td><td>{}</td></tr>",
+            ctrl_page(c),
+            esc(&c.name),
+            esc(c.title.as_deref().unwrap_or("")),
+            esc(cpu),
+            plans.join(" ")
+        );
+    }
+    out.push_str("</table>\n");
+    out
+}
+
+/// The table of the buffers `which` (indexes) with the writer and readers
+/// of each (nothing when there are none); `prefix` as for
+/// [`controllers_table`].
+pub(super) fn buffers_table(ir: &Ir, prefix: &str, which: &[usize]) -> String {
+    let mut out = String::new();
+    if !which.is_empty() {
+        out.push_str("<h3>Buffers</h3>\n<table>\n<tr><th>buffer</th><th>type</th><th>written by</th><th>read by</th></tr>\n");
+        for b in which.iter().filter_map(|b| ir.buffers.get(*b)) {
+            let link = |c: rcs_dsl::ir::CtrlId| {
+                let c = ir.controller(c);
+                format!("<a href=\"{prefix}{}\">{}</a>", ctrl_page(c), esc(&c.name))
+            };
+            let writer = b
+                .writer
+                .map(link)
+                .unwrap_or_else(|| "an external input".into());
+            let readers: Vec<String> = b.readers.iter().map(|r| link(*r)).collect();
+            let _ = writeln!(
+                out,
+                "<tr id=\"{}\"><td>{}</td><td>{}</td><td>{writer}</td><td>{}</td></tr>",
+                esc(&buffer_anchor(ir, &b.name)),
+                esc(&b.name),
+                esc(&ir.buffer_types[b.ty.index()].name),
+                readers.join(", ")
+            );
+        }
+        out.push_str("</table>\n");
+    }
+    out
 }
 
 /// A JSON string literal.
@@ -145,11 +174,15 @@ pub(super) fn search_js(site: &Site) -> String {
                 }
             }
         }
-        for b in &ir.buffers {
+        for (bi, b) in ir.buffers.iter().enumerate() {
             entries.push((
                 b.name.clone(),
                 "buffer",
-                format!("index.html#{}", buffer_anchor(ir, &b.name)),
+                format!(
+                    "{}#{}",
+                    buffers_href(site, set, bi),
+                    buffer_anchor(ir, &b.name)
+                ),
             ));
         }
     }

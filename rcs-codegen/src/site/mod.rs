@@ -10,6 +10,10 @@
 //!                           site.css, site.js, search.js
 //! ```
 //!
+//! A set of more than [`LARGE_SET`] controllers is drawn cluster by
+//! cluster ([`clusters`]); with a diff (`rcsc doc --diff`) the site gets a
+//! Changes page ([`changes`]).
+//!
 //! The pages link by the `id`s [`crate::dot`] gives nodes and edges
 //! (`node-S1`, `edge-E3`, `ctrl-PR`): [`svg`] turns each id into a link
 //! (`URL`) and, with run counts, a line width and a class, before the DOT
@@ -19,6 +23,8 @@
 //! Anchors a page offers: `row-E<N>` (a table row), `state-<S>` (a state),
 //! `L<line>` (a source line), `edge-E<N>` / `node-<S>` (in the SVG).
 
+mod changes;
+mod clusters;
 mod controller;
 mod html;
 mod index;
@@ -26,6 +32,7 @@ mod plan;
 pub mod runs;
 mod svg;
 
+pub use clusters::{CLUSTER_MAX, LARGE_SET, LIST_PAGE};
 pub use runs::RunCounts;
 
 use crate::OutputFile;
@@ -49,6 +56,15 @@ pub struct SetDoc<'a> {
 pub struct Site<'a> {
     pub sets: Vec<SetDoc<'a>>,
     pub shared: bool,
+    /// With `rcsc doc --diff`: what the plans change, for the Changes page.
+    pub changes: Option<Changes<'a>>,
+}
+
+/// A semantic diff of the documented plans against an older version.
+pub struct Changes<'a> {
+    pub diff: &'a rcs_dsl::diff::PlanSetDiff,
+    /// The older version, as the user named it (`HEAD~1`, a path).
+    pub against: String,
 }
 
 /// A graph to render: its key (for [`pages`]) and its DOT text.
@@ -93,10 +109,14 @@ pub fn graphs(site: &Site) -> Vec<GraphSource> {
     let mut out = Vec::new();
     for set in &site.sets {
         let folder = folder(site, set);
-        out.push(GraphSource {
-            key: hierarchy_key(&folder),
-            dot: svg::link_hierarchy(&crate::dot::hierarchy_graph(set.ir), &folder),
-        });
+        if clusters::is_large(set.ir) {
+            out.extend(cluster_graphs(set.ir, &folder));
+        } else {
+            out.push(GraphSource {
+                key: hierarchy_key(&folder),
+                dot: svg::link_hierarchy(&crate::dot::hierarchy_graph(set.ir), &folder),
+            });
+        }
         for ctrl in &set.ir.controllers {
             for plan in &ctrl.plans {
                 let dot = crate::dot::plan_graph(set.ir, ctrl, plan);
@@ -108,7 +128,36 @@ pub fn graphs(site: &Site) -> Vec<GraphSource> {
             }
         }
     }
+    if let Some(c) = &site.changes {
+        out.extend(changes::graphs(c));
+    }
     out
+}
+
+/// A large set's graphs: the overview of its clusters, then each cluster.
+fn cluster_graphs(ir: &Ir, folder: &str) -> Vec<GraphSource> {
+    let all = clusters::clusters(ir);
+    let mut out = vec![GraphSource {
+        key: clusters::overview_key(folder),
+        dot: clusters::overview_graph(ir, &all, folder),
+    }];
+    for (k, cl) in all.iter().enumerate() {
+        out.push(GraphSource {
+            key: clusters::cluster_key(folder, cl),
+            dot: clusters::cluster_graph(ir, &all, k),
+        });
+    }
+    out
+}
+
+/// Where a set's buffer `b` (index) is listed, from the site's root: the
+/// index, or the page of a large set's list of buffers that shows it.
+fn buffers_href(site: &Site, set: &SetDoc, b: usize) -> String {
+    if clusters::is_large(set.ir) {
+        format!("{}{}", folder(site, set), clusters::buffer_list_page(b))
+    } else {
+        "index.html".into()
+    }
 }
 
 /// Every page of the site, given the rendered graphs.
@@ -132,8 +181,17 @@ pub fn pages(site: &Site, svgs: &Svgs) -> Vec<OutputFile> {
             contents: index::index_page(site, svgs, &placed),
         },
     ];
+    if let Some(c) = &site.changes {
+        files.push(OutputFile {
+            path: changes::CHANGES_PAGE.into(),
+            contents: changes::changes_page(site, c, svgs),
+        });
+    }
     for (set, placed) in site.sets.iter().zip(&placed) {
         let folder = folder(site, set);
+        if clusters::is_large(set.ir) {
+            files.extend(clusters::pages(site, set, svgs));
+        }
         for (ci, ctrl) in set.ir.controllers.iter().enumerate() {
             files.push(OutputFile {
                 path: format!("{folder}{}", ctrl_page(ctrl)),

@@ -124,6 +124,7 @@ pub(super) fn plan_page(
         esc(&ctrl.name),
         esc(&verb.name)
     );
+    body.push_str(&super::changes::plan_badge(site, set, ctrl, plan, root));
     body.push_str(&docs(&verb.docs));
     body.push_str(&docs(&plan.docs));
     if let Some(r) = set.runs {

@@ -1,13 +1,29 @@
 // The site's only script: the search box over controllers, verbs, buffers
-// and states (window.RCS_SEARCH, from search.js), and a highlight on the
-// graph element a row or state link points at. Works from file:// URLs.
+// and states. Its index (window.RCS_SEARCH, search.js: megabytes for a
+// large set) is loaded when the box is first focused or typed in, so no
+// page pays for it at load. Works from file:// URLs.
 (function () {
   "use strict";
   var root = document.body.getAttribute("data-root") || "";
   var box = document.getElementById("search");
   var list = document.getElementById("results");
-  var index = window.RCS_SEARCH || [];
+  var index = null;
+  var loading = false;
+  // Load search.js once; show the results for what was typed meanwhile.
+  function load() {
+    if (index || loading) { return; }
+    if (window.RCS_SEARCH) { index = window.RCS_SEARCH; return; }
+    loading = true;
+    var script = document.createElement("script");
+    script.src = root + "search.js";
+    script.onload = function () {
+      index = window.RCS_SEARCH || [];
+      show(box.value);
+    };
+    document.head.appendChild(script);
+  }
   function show(query) {
+    if (!index) { return; }
     while (list.firstChild) { list.removeChild(list.firstChild); }
     var q = query.trim().toLowerCase();
     if (!q) { list.hidden = true; return; }
@@ -30,7 +46,8 @@
     list.hidden = shown === 0;
   }
   if (box && list) {
-    box.addEventListener("input", function () { show(box.value); });
+    box.addEventListener("focus", load);
+    box.addEventListener("input", function () { load(); show(box.value); });
     box.addEventListener("keydown", function (ev) {
       if (ev.key === "Enter") {
         var first = list.querySelector("a");

@@ -46,13 +46,21 @@ pub(super) fn index_page(site: &Site, svgs: &Svgs, placed: &[Placed]) -> String 
             body.push_str(&finding(d));
         }
         body.push_str("<h3>Controllers</h3>\n<table>\n<tr><th>controller</th><th>title</th><th>CPU</th><th>supervisor</th><th>plans</th></tr>\n");
+        // With several processes, the CPU column names the process too.
+        let distributed = rcs_dsl::placement::Placement::of(ir).is_distributed();
         for (ci, c) in ir.controllers.iter().enumerate() {
             let cpu = ir
                 .schedule
                 .iter()
                 .find(|cpu| cpu.order.iter().any(|o| o.index() == ci))
-                .map(|cpu| cpu.name.as_str())
-                .unwrap_or("—");
+                .map(|cpu| {
+                    if distributed {
+                        format!("{} (process {})", cpu.name, ir.process_of(cpu))
+                    } else {
+                        cpu.name.clone()
+                    }
+                })
+                .unwrap_or_else(|| "—".into());
             let sup = match c.supervisor {
                 Some(s) => {
                     let s = ir.controller(s);
@@ -77,7 +85,7 @@ pub(super) fn index_page(site: &Site, svgs: &Svgs, placed: &[Placed]) -> String 
                 ctrl_page(c),
                 esc(&c.name),
                 esc(c.title.as_deref().unwrap_or("")),
-                esc(cpu),
+                esc(&cpu),
                 plans.join(" ")
             );
         }

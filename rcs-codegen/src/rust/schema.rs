@@ -17,7 +17,7 @@ use super::names::Names;
 pub(crate) fn derives(names: &Names) -> TokenStream {
     if names.wire {
         quote! {
-            #[derive(rt::serde::Serialize, rt::serde::Deserialize)]
+            #[derive(::rcs_runtime::serde::Serialize, ::rcs_runtime::serde::Deserialize)]
             #[serde(crate = "rcs_runtime::serde")]
         }
     } else {
@@ -39,8 +39,8 @@ pub(crate) fn schema_impl(
         return quote!();
     }
     quote! {
-        impl rt::Schema for #ty {
-            const SCHEMA: u64 = rt::schema::combine(#structure, &[#(<#parts as rt::Schema>::SCHEMA),*]);
+        impl ::rcs_runtime::Schema for #ty {
+            const SCHEMA: u64 = ::rcs_runtime::schema::combine(#structure, &[#(<#parts as ::rcs_runtime::Schema>::SCHEMA),*]);
         }
     }
 }

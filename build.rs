@@ -80,7 +80,9 @@ fn sections(toml: &str) -> BTreeMap<String, BTreeMap<String, String>> {
 }
 
 /// The runtime's manifest with every `workspace = true` resolved. Keeps
-/// `[package]`, `[dependencies]` and `[features]`; stops the build on a form
+/// `[package]`, `[dependencies]` and `[features]`, less the optional
+/// dependencies (the Zenoh bridge's) and the features that only turn them
+/// on, which the one-process compiled backend never uses; stops the build on a form
 /// it does not know rather than ship a manifest cargo would read otherwise.
 fn standalone_manifest(manifest: &str, workspace: &str) -> String {
     let ws = sections(workspace);
@@ -93,13 +95,15 @@ fn standalone_manifest(manifest: &str, workspace: &str) -> String {
     let mut out = String::new();
     let mut keep = false;
     let mut section = String::new();
+    let mut dropped_deps: Vec<String> = Vec::new();
+    let mut dropped_features: Vec<String> = Vec::new();
     for line in manifest.lines() {
         let trimmed = line.trim();
         if trimmed.starts_with('[') {
             section = trimmed.trim_matches(|c| c == '[' || c == ']').to_string();
             keep = matches!(section.as_str(), "package" | "dependencies" | "features");
             assert!(
-                keep || matches!(section.as_str(), "dev-dependencies" | "bench"),
+                keep || matches!(section.as_str(), "dev-dependencies" | "bench" | "example"),
                 "rcs-runtime/Cargo.toml: build.rs does not know what to do with [{section}]"
             );
             if keep {
@@ -114,6 +118,27 @@ fn standalone_manifest(manifest: &str, workspace: &str) -> String {
         }
         let (key, value) = trimmed.split_once('=').expect("a `key = value` line");
         let (key, value) = (key.trim(), value.trim());
+        // The shipped copy runs one process: no optional dependency (the
+        // Zenoh bridge's), and no feature that only turns them on.
+        if section == "dependencies" && value.replace(' ', "").contains("optional=true") {
+            dropped_deps.push(key.to_string());
+            continue;
+        }
+        if section == "features" {
+            let needs_dropped = value
+                .trim_matches(|c| c == '[' || c == ']')
+                .split(',')
+                .map(|d| d.trim().trim_matches('"'))
+                .filter(|d| !d.is_empty())
+                .all(|d| {
+                    d.strip_prefix("dep:")
+                        .is_some_and(|n| dropped_deps.iter().any(|x| x == n))
+                });
+            if needs_dropped {
+                dropped_features.push(key.to_string());
+                continue;
+            }
+        }
         let resolved = if let Some(name) = key.strip_suffix(".workspace") {
             assert_eq!(value, "true", "{trimmed}");
             let from = if section == "package" {
@@ -135,6 +160,15 @@ fn standalone_manifest(manifest: &str, workspace: &str) -> String {
         };
         out.push_str(&resolved);
         out.push('\n');
+    }
+    if !dropped_features.is_empty() {
+        // The sources still say `#[cfg(feature = "zenoh")]`: a known name,
+        // never on.
+        let names: Vec<String> = dropped_features.iter().map(|f| format!("{f:?}")).collect();
+        out.push_str(&format!(
+            "\n[lints.rust]\nunexpected_cfgs = {{ level = \"warn\", check-cfg = ['cfg(feature, values({}))'] }}\n",
+            names.join(", ")
+        ));
     }
     out.trim_start().to_string()
 }

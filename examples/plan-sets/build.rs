@@ -25,6 +25,12 @@ fn module_name(path: &Path) -> String {
     format!("set_{s}")
 }
 
+/// Whether the plan set at `path` has a manifest that names a `process:`.
+fn places_processes(path: &Path) -> bool {
+    std::fs::read_to_string(path.join("rcs.yaml"))
+        .is_ok_and(|m| m.lines().any(|l| l.trim_start().starts_with("process:")))
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = PathBuf::from(std::env::var("OUT_DIR")?);
     let mut includes = String::new();
@@ -42,6 +48,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let is_set = path.is_dir() && name != "snapshots"
                 || path.extension().is_some_and(|e| e == "rcs");
             if !is_set {
+                continue;
+            }
+            // A set placed in several processes generates `System::process`,
+            // which needs rcs-runtime's Zenoh bridge: compiled only with this
+            // crate's feature `zenoh`, so that a build without it compiles
+            // nothing from Zenoh.
+            if std::env::var_os("CARGO_FEATURE_ZENOH").is_none() && places_processes(&path) {
                 continue;
             }
             let module = module_name(&path);

@@ -25,7 +25,8 @@
 //! (`crate::diff_dot`), which colour each line by what a change did to it.
 
 use crate::GENERATED;
-use rcs_dsl::ir::{Controller, From, Ir, Plan, Row, Target};
+use rcs_dsl::ir::{Controller, Cpu, From, Ir, Plan, Row, Target};
+use rcs_dsl::placement::Placement;
 use rcs_dsl::pretty::Printer;
 use std::fmt::Write;
 
@@ -362,7 +363,8 @@ pub(crate) fn graph_head(out: &mut String, name: &str, title: &str, docs: &[Stri
     out.push_str("    node [fontname=\"Helvetica\", shape=circle];\n");
     out.push_str("    edge [fontname=\"Helvetica\", fontsize=10];\n");
 }
-/// The controller tree, one cluster per executive ("CPU").
+/// The controller tree, one cluster per executive ("CPU"), inside one
+/// cluster per process when the manifest places CPUs in several.
 pub fn hierarchy_graph(ir: &Ir) -> String {
     let mut out = String::new();
     let _ = writeln!(out, "// {GENERATED} for system {}. Do not edit.", ir.system);
@@ -373,31 +375,35 @@ pub fn hierarchy_graph(ir: &Ir) -> String {
         quoted(&format!("{} hierarchy", ir.system))
     );
     out.push_str("    node [fontname=\"Helvetica\", shape=box, style=rounded];\n");
-    for (i, cpu) in ir.schedule.iter().enumerate() {
-        let _ = writeln!(out, "    subgraph {} {{", quoted(&format!("cluster_{i}")));
-        let _ = writeln!(
-            out,
-            "        label={}; style=dashed; fontname=\"Helvetica\";",
-            quoted(&format!("CPU {} · {}", cpu.name, period(cpu.period_ns)))
-        );
-        for c in &cpu.order {
-            let ctrl = ir.controller(*c);
-            let mut label = html(&ctrl.name);
-            if let Some(t) = ctrl.title.as_ref().filter(|t| !t.is_empty()) {
-                let _ = write!(label, "<BR/><FONT POINT-SIZE=\"9\">{}</FONT>", html(t));
-            }
-            if let Some(l) = ctrl.level {
-                let _ = write!(label, "<BR/><FONT POINT-SIZE=\"8\">level {l}</FONT>");
-            }
+    // With several processes, one cluster per process around its CPUs'
+    // clusters; with one, the CPU clusters alone (as before placement).
+    let placement = Placement::of(ir);
+    let distributed = placement.is_distributed();
+    for (p, process) in placement.processes.iter().enumerate() {
+        let indent = if distributed { "    " } else { "" };
+        if distributed {
             let _ = writeln!(
                 out,
-                "        {} [id={}, label=<{label}>, tooltip={}];",
-                quoted(&ctrl.name),
-                quoted(&ctrl_id(&ctrl.name)),
-                quoted(&ctrl.docs.join("\n"))
+                "    subgraph {} {{",
+                quoted(&format!("cluster_process_{p}"))
+            );
+            let _ = writeln!(
+                out,
+                "        label={}; style=solid; fontname=\"Helvetica\";",
+                quoted(&format!("process {process}"))
             );
         }
-        out.push_str("    }\n");
+        let cpus = ir
+            .schedule
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| placement.cpu_process.get(*i) == Some(&p));
+        for (i, cpu) in cpus {
+            cpu_cluster(&mut out, ir, indent, i, cpu);
+        }
+        if distributed {
+            out.push_str("    }\n");
+        }
     }
     for ctrl in &ir.controllers {
         for s in &ctrl.subordinates {
@@ -411,6 +417,39 @@ pub fn hierarchy_graph(ir: &Ir) -> String {
     }
     out.push_str("}\n");
     out
+}
+
+/// One executive's cluster of the hierarchy graph, its lines indented by
+/// `indent` more than a top-level cluster's.
+fn cpu_cluster(out: &mut String, ir: &Ir, indent: &str, i: usize, cpu: &Cpu) {
+    let _ = writeln!(
+        out,
+        "{indent}    subgraph {} {{",
+        quoted(&format!("cluster_{i}"))
+    );
+    let _ = writeln!(
+        out,
+        "{indent}        label={}; style=dashed; fontname=\"Helvetica\";",
+        quoted(&format!("CPU {} · {}", cpu.name, period(cpu.period_ns)))
+    );
+    for c in &cpu.order {
+        let ctrl = ir.controller(*c);
+        let mut label = html(&ctrl.name);
+        if let Some(t) = ctrl.title.as_ref().filter(|t| !t.is_empty()) {
+            let _ = write!(label, "<BR/><FONT POINT-SIZE=\"9\">{}</FONT>", html(t));
+        }
+        if let Some(l) = ctrl.level {
+            let _ = write!(label, "<BR/><FONT POINT-SIZE=\"8\">level {l}</FONT>");
+        }
+        let _ = writeln!(
+            out,
+            "{indent}        {} [id={}, label=<{label}>, tooltip={}];",
+            quoted(&ctrl.name),
+            quoted(&ctrl_id(&ctrl.name)),
+            quoted(&ctrl.docs.join("\n"))
+        );
+    }
+    let _ = writeln!(out, "{indent}    }}");
 }
 
 /// A period as people write it: `30 ms`, `500 µs`, `1 s`.

@@ -61,11 +61,12 @@ pub enum Code {
     Lint(Lint),
     EveryCycleDecision,
     EveryCycleTwice,
+    Placement,
 }
 
 impl Code {
     /// Every hard-error code, in catalogue order (lints follow in [`Lint::ALL`]).
-    pub const ERRORS: [Code; 30] = [
+    pub const ERRORS: [Code; 31] = [
         Code::Syntax,
         Code::DuplicateDefinition,
         Code::UnknownName,
@@ -96,6 +97,7 @@ impl Code {
         Code::ForwardMismatch,
         Code::EveryCycleDecision,
         Code::EveryCycleTwice,
+        Code::Placement,
     ];
 
     pub fn name(self) -> &'static str {
@@ -131,6 +133,7 @@ impl Code {
             Code::Lint(l) => l.name(),
             Code::EveryCycleDecision => "every_cycle_decision",
             Code::EveryCycleTwice => "every_cycle_twice",
+            Code::Placement => "placement",
         }
     }
 
@@ -197,6 +200,9 @@ impl Code {
                 "a `pre` or `post` block sends, reports or changes state: decisions belong in the rows"
             }
             Code::EveryCycleTwice => "a controller has two `pre` or two `post` blocks",
+            Code::Placement => {
+                "a CPU's `process:` or `inputs:` in `rcs.yaml` does not place it"
+            }
         }
     }
 

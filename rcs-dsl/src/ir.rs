@@ -607,9 +607,22 @@ pub struct Cpu {
     pub name: String,
     pub period_ns: u64,
     pub order: Vec<CtrlId>,
+    /// The manifest's `process:`; `None` is the default process, named
+    /// after the system ([`Ir::process_of`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub process: Option<String>,
+    /// External inputs written by hand-written code in this CPU's process
+    /// (the manifest's `inputs:`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub inputs: Vec<BufferId>,
 }
 
 impl Ir {
+    /// The process CPU `cpu` runs in: its `process:`, or the system's name.
+    pub fn process_of<'a>(&'a self, cpu: &'a Cpu) -> &'a str {
+        cpu.process.as_deref().unwrap_or(&self.system)
+    }
+
     pub fn controller(&self, id: CtrlId) -> &Controller {
         &self.controllers[id.index()]
     }

@@ -35,6 +35,7 @@ mod lower;
 pub mod manifest;
 mod parallel;
 pub mod parser;
+pub mod placement;
 pub mod pretty;
 pub mod render;
 pub mod scenario;

@@ -40,6 +40,12 @@ pub struct CpuSpec {
     pub span: Span,
     pub period_ns: u64,
     pub order: Vec<(String, Span)>,
+    /// `process:`: the program this CPU runs in (`None`: the default
+    /// process, named after the system). See `docs/distribution.md`.
+    pub process: Option<(String, Span)>,
+    /// `inputs:`: external buffers (no controller writes them) that
+    /// hand-written code in this CPU's process writes.
+    pub inputs: Vec<(String, Span)>,
 }
 
 #[derive(Deserialize)]
@@ -66,6 +72,8 @@ struct RawCpu {
     cpu: Spanned<String>,
     period: Option<Spanned<String>>,
     order: Vec<Spanned<String>>,
+    process: Option<Spanned<String>>,
+    inputs: Option<Vec<Spanned<String>>>,
 }
 
 /// Parse a manifest. Every problem is a `manifest` diagnostic in `file`.
@@ -92,7 +100,7 @@ pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>>
             let d = if label == "unknown key" || label == "here" && message.contains("field") {
                 d.with_help(
                     "known keys: system, plans, workspace, limits {max_rules_per_plan, max_subordinates}, \
-                     lints {LINT: allow|warn|deny}, schedule [{cpu, period, order}]",
+                     lints {LINT: allow|warn|deny}, schedule [{cpu, period, order, process, inputs}]",
                 )
             } else {
                 d
@@ -246,7 +254,21 @@ pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>>
                     "second entry for this CPU",
                 ));
             }
+            let process = cpu
+                .process
+                .as_ref()
+                .map(|p| (p.value.clone(), spanned(&p.referenced)));
+            if let Some((name, span)) = &process {
+                diags.extend(crate::placement::check_process_name(name, *span));
+            }
             cpus.push(CpuSpec {
+                process,
+                inputs: cpu
+                    .inputs
+                    .iter()
+                    .flatten()
+                    .map(|i| (i.value.clone(), spanned(&i.referenced)))
+                    .collect(),
                 name: cpu.cpu.value.clone(),
                 span,
                 period_ns,

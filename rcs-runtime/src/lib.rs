@@ -17,6 +17,8 @@
 //! | [`math`] | the float built-in functions of the language (`sqrt`, `min`, …), shared by generated code and the interpreter |
 //! | [`operator`] | [`Operator`]: command a root controller, read status |
 //! | [`trace`] | optional JSON-lines trace of every controller's cycle |
+//! | [`schema`] | [`Schema`]: a stable hash of a buffer type's structure |
+//! | `bridge` | (feature `zenoh`) Global Memory across processes over Zenoh |
 //! | `seqlock` | the only `unsafe` code: the sequence lock behind Global Memory |
 //!
 //! ## Costs
@@ -178,6 +180,8 @@
 
 #![warn(missing_docs)]
 
+#[cfg(feature = "zenoh")]
+pub mod bridge;
 pub mod driver;
 pub mod error;
 pub mod exec;
@@ -187,9 +191,12 @@ pub mod index;
 pub mod math;
 pub mod operator;
 pub mod plan;
+pub mod schema;
 mod seqlock;
 pub mod trace;
 
+#[cfg(feature = "zenoh")]
+pub use bridge::{Bridge, BridgeConfig, BridgeError};
 pub use error::SetupError;
 pub use exec::{
     Controller, ControllerStats, CycleContext, Executive, ExecutiveConfig, ExecutiveHandle,
@@ -205,6 +212,11 @@ pub use handshake::{
 };
 pub use operator::{read_status, Operator};
 pub use plan::{Bookkeeping, NewCommand, SampleStats, Target, Tick, VerbStats};
+pub use schema::Schema;
+/// serde, for the `#[serde(crate = "rcs_runtime::serde")]` of generated
+/// types of multi-process plan sets (their crates need not depend on serde).
+#[doc(hidden)]
+pub use serde;
 pub use trace::{read_trace, TraceError, TraceHeader, TraceRecord, TraceSink, TRACE_VERSION};
 
 /// Include the Rust code `rcsc` generated for a plan set from a build script.

@@ -132,3 +132,93 @@ fn ten_thousand_cycles_allocate_nothing() {
     assert!(done >= 60, "commands completed: {done}");
     assert_eq!(allocations, 0, "heap allocations on the cycle path");
 }
+
+/// The same hierarchy split over two Global Memories joined by Zenoh
+/// bridges (TB in "process" B, on a thread of its own): the cycles of SM
+/// and PR still allocate nothing while the bridges carry TB's command and
+/// status back and forth.
+#[cfg(feature = "zenoh")]
+#[test]
+fn cycles_allocate_nothing_with_the_bridge_running() {
+    use rcs_runtime::{Bridge, BridgeConfig, CommandBuffer, StatusBuffer};
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::time::Instant;
+
+    let port = std::net::TcpListener::bind("127.0.0.1:0")
+        .and_then(|l| l.local_addr())
+        .expect("a free port")
+        .port();
+    let ep = format!("tcp/127.0.0.1:{port}");
+    let (gm_a, gm_b) = (GlobalMemory::new(), GlobalMemory::new());
+    gm_a.declare_controller::<VerbId>("TB").unwrap();
+    let mut exec = Executive::new(ExecutiveConfig::new("helm", Duration::from_millis(1))).unwrap();
+    exec.add(Box::new(Relay::new(&gm_a, "SM", Some("PR"), 0).unwrap()))
+        .unwrap();
+    exec.add(Box::new(Relay::new(&gm_a, "PR", Some("TB"), 0).unwrap()))
+        .unwrap();
+    let mut engine =
+        Executive::new(ExecutiveConfig::new("engine", Duration::from_millis(1))).unwrap();
+    engine
+        .add(Box::new(Relay::new(&gm_b, "TB", None, 3).unwrap()))
+        .unwrap();
+    let mut a = Bridge::builder(BridgeConfig::new("noalloc", "helm").listen(&ep), &gm_a);
+    a.export::<CommandBuffer<VerbId>>("TB.command").unwrap();
+    a.import::<StatusBuffer>("TB.status").unwrap();
+    let a = a.start().unwrap();
+    let mut b = Bridge::builder(BridgeConfig::new("noalloc", "engine").connect(&ep), &gm_b);
+    b.import::<CommandBuffer<VerbId>>("TB.command").unwrap();
+    b.export::<StatusBuffer>("TB.status").unwrap();
+    let _b = b.start().unwrap();
+    let stop = Arc::new(AtomicBool::new(false));
+    let engine_thread = {
+        let stop = Arc::clone(&stop);
+        std::thread::spawn(move || {
+            while !stop.load(Ordering::Relaxed) {
+                engine.step();
+                std::thread::sleep(Duration::from_millis(1));
+            }
+        })
+    };
+    let mut op = Operator::<VerbId>::connect(&gm_a, "SM").unwrap();
+    let tb_status = gm_a.reader::<StatusBuffer>("TB.status").unwrap();
+    // Warm up until the link carries TB's status (bounded).
+    op.command(GO);
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while tb_status.generation() == 0 && Instant::now() < deadline {
+        exec.run_cycles(1);
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    assert!(
+        tb_status.generation() > 0,
+        "the bridge never carried TB's status"
+    );
+
+    // Measure SM's and PR's cycles until the bridge has delivered 50 more of
+    // TB's statuses into this Global Memory (bounded by a deadline).
+    let start_gen = tb_status.generation();
+    let imported_before = a.stats().imported;
+    let (allocations, cycles) = allocations_in(|| {
+        let mut cycles = 0u64;
+        while tb_status.generation() < start_gen + 50 && Instant::now() < deadline {
+            if cycles.is_multiple_of(40) {
+                op.command(if cycles.is_multiple_of(120) { HOLD } else { GO });
+            }
+            exec.run_cycles(1);
+            cycles += 1;
+            std::thread::sleep(Duration::from_micros(500));
+        }
+        cycles
+    });
+    stop.store(true, Ordering::Relaxed);
+    engine_thread.join().unwrap();
+    assert!(
+        tb_status.generation() >= start_gen + 50,
+        "the bridge stalled"
+    );
+    assert!(a.stats().imported > imported_before);
+    assert!(cycles > 0);
+    assert_eq!(
+        allocations, 0,
+        "heap allocations on the cycle path with the bridge running"
+    );
+}

@@ -73,10 +73,19 @@ pub(crate) fn module(
     let verb_count = c.commands.len();
     let no_commands_doc = format!(" `{name}` accepts no commands.");
     let command_enum = if c.commands.is_empty() {
+        let wire = super::schema::derives(names);
+        let schema = super::schema::schema_impl(
+            names,
+            &quote!(Command),
+            &format!("command {name}{{}}"),
+            &[],
+        );
         quote! {
             #[doc = #no_commands_doc]
+            #wire
             #[derive(Clone, Copy, Debug, Default, PartialEq)]
             pub struct Command;
+            #schema
             impl rt::Command for Command {
                 fn verb(&self) -> rt::VerbId { 0 }
             }
@@ -127,11 +136,36 @@ pub(crate) fn module(
                 },
             )
         };
+        let wire = super::schema::derives(names);
+        let param_tys: Vec<TokenStream> = c
+            .commands
+            .iter()
+            .flat_map(|k| k.params.iter().map(|p| rust_type(names, &p.ty)))
+            .collect();
+        let structure = format!(
+            "command {name}{{{}}}",
+            c.commands
+                .iter()
+                .map(|k| format!(
+                    "{}({})",
+                    k.name,
+                    k.params
+                        .iter()
+                        .map(|p| format!("{}:{}", p.name, rust_type(names, &p.ty)))
+                        .collect::<Vec<_>>()
+                        .join(",")
+                ))
+                .collect::<Vec<_>>()
+                .join(",")
+        );
+        let schema = super::schema::schema_impl(names, &quote!(Command), &structure, &param_tys);
         quote! {
             #[doc = #cmd_doc]
+            #wire
             #[derive(Clone, Copy, Debug, #derive_default PartialEq)]
             pub enum Command { #(#variants),* }
             #default_impl
+            #schema
             impl rt::Command for Command {
                 fn verb(&self) -> rt::VerbId {
                     match self { #(#arms),* }

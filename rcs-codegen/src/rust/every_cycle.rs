@@ -87,16 +87,34 @@ pub(crate) fn parts(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments) 
             " `{}`'s status fields, published every cycle in Global Memory buffer `{}.status_fields` (zero before its first cycle).",
             c.name, c.name
         );
+        let wire = super::schema::derives(names);
+        let structure = format!(
+            "status_fields {}{{{}}}",
+            c.name,
+            own.iter()
+                .zip(&tys)
+                .map(|((_, v), t)| format!("{}:{}", v.name, t))
+                .collect::<Vec<_>>()
+                .join(",")
+        );
+        p.items.extend(super::schema::schema_impl(
+            names,
+            &quote!(StatusFields),
+            &structure,
+            &tys,
+        ));
         // Zero is every type's `Default` where std can derive it (arrays up to 32).
         if own.iter().all(|(_, v)| derivable_default(&v.ty)) {
             p.items.extend(quote! {
                 #[doc = #doc]
+                #wire
                 #[derive(Clone, Copy, Debug, Default, PartialEq)]
                 pub struct StatusFields { #(#docs pub #fields: #tys),* }
             });
         } else {
             p.items.extend(quote! {
                 #[doc = #doc]
+                #wire
                 #[derive(Clone, Copy, Debug, PartialEq)]
                 pub struct StatusFields { #(#docs pub #fields: #tys),* }
                 impl Default for StatusFields {

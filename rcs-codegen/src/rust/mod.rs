@@ -12,6 +12,8 @@ mod expr;
 mod index;
 mod names;
 mod plan;
+mod process;
+mod schema;
 mod system;
 mod types;
 mod verbs;
@@ -71,7 +73,10 @@ pub fn system_module(ir: &Ir, options: &crate::Options) -> String {
     } else {
         TokenStream::new()
     };
+    // A distributed set's types travel over the bridge: serde through the
+    // runtime's re-export, whatever `options.serde` says.
     let serde = match &options.serde {
+        _ if names.wire => Some(schema::derives(&names)),
         crate::SerdeDerives::Off => None,
         crate::SerdeDerives::Always => {
             Some(quote!(#[derive(::serde::Serialize, ::serde::Deserialize)]))

@@ -45,6 +45,10 @@ pub(crate) struct Names {
     pub ctrls: Vec<CtrlNames>,
     /// Field of `Inputs`/`Outputs` per Global Memory buffer.
     pub gm_buffers: Vec<Ident>,
+    /// Whether the manifest places CPUs in more than one process: then
+    /// every type that can sit in a buffer also travels over the Zenoh
+    /// bridge (serde derives and a schema hash, [`super::schema`]).
+    pub wire: bool,
 }
 
 fn idents(v: Vec<String>) -> Vec<Ident> {
@@ -203,6 +207,7 @@ impl Names {
             buffers,
             ctrls,
             gm_buffers,
+            wire: rcs_dsl::placement::Placement::of(ir).is_distributed(),
         }
     }
 }

@@ -9,6 +9,7 @@ use proc_macro2::Ident;
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 use rcs_dsl::ir::Ir;
+use rcs_dsl::placement::Placement;
 
 pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
     // At the system module's top level the schemas are `types::X`.
@@ -129,7 +130,7 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
         None => quote!(()),
     };
 
-    let executives = ir.schedule.iter().map(|cpu| {
+    let executives: Vec<TokenStream> = ir.schedule.iter().map(|cpu| {
         let name = &cpu.name;
         let period = cpu.period_ns;
         let adds = cpu.order.iter().map(|c| {
@@ -146,7 +147,7 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
             #(#adds)*
             executives.push(exec);
         }}
-    });
+    }).collect();
     let system_doc = format!(
         " The `{}` system: Global Memory, its executives and the handles the outside world uses.",
         ir.system
@@ -175,11 +176,52 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
         }
     });
 
+    // A distributed set's process writes only some external inputs: the
+    // others' writers are `None` there (`System::process`).
+    let placement = Placement::of(ir);
+    let distributed = placement.is_distributed();
+    let (in_field_tys, in_inits): (Vec<TokenStream>, Vec<TokenStream>) = in_tys
+        .iter()
+        .zip(&in_names)
+        .map(|(ty, name)| {
+            if distributed {
+                (
+                    quote!(Option<rt::Writer<#ty>>),
+                    quote!(Some(gm.writer(#name)?)),
+                )
+            } else {
+                (quote!(rt::Writer<#ty>), quote!(gm.writer(#name)?))
+            }
+        })
+        .unzip();
+    let declare_all = quote!(#(gm.declare::<#all_tys>(#all_names)?;)*);
+    let outputs = quote!(Outputs { #(#out_fields: gm.reader(#out_names)?),* });
+    let operators =
+        quote!(Operators { #(#root_fields: rt::Operator::connect(&gm, #root_names)?),* });
+    let process_api = if distributed {
+        super::process::process_api(
+            ir,
+            names,
+            &placement,
+            &super::process::Shared {
+                declare_all: declare_all.clone(),
+                executives: &executives,
+                outputs: outputs.clone(),
+                operators: operators.clone(),
+                bounds: bounds.clone(),
+                generics: generics.clone(),
+                hooks_param: hooks_param.clone(),
+            },
+        )
+    } else {
+        quote!()
+    };
+
     quote! {
         /// Global Memory buffers no controller writes: sensor drivers and
         /// simulators write them through these handles (one writer each).
         #[derive(Debug)]
-        pub struct Inputs { #(#in_docs pub #in_fields: rt::Writer<#in_tys>),* }
+        pub struct Inputs { #(#in_docs pub #in_fields: #in_field_tys),* }
 
         /// Readers of the buffers the controllers write, for actuators,
         /// simulators and displays.
@@ -223,13 +265,13 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
             /// its hooks from `hooks`.
             pub fn new(#hooks_param: Hooks #generics) -> Result<Self, rt::SetupError> {
                 let gm = rt::GlobalMemory::new();
-                #(gm.declare::<#all_tys>(#all_names)?;)*
+                #declare_all
                 let mut executives = Vec::new();
                 #(#executives)*
                 Ok(Self {
-                    inputs: Inputs { #(#in_fields: gm.writer(#in_names)?),* },
-                    outputs: Outputs { #(#out_fields: gm.reader(#out_names)?),* },
-                    operators: Operators { #(#root_fields: rt::Operator::connect(&gm, #root_names)?),* },
+                    inputs: Inputs { #(#in_fields: #in_inits),* },
+                    outputs: #outputs,
+                    operators: #operators,
                     gm,
                     executives,
                     hooks: ::core::marker::PhantomData,
@@ -248,6 +290,8 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
                 }
             }
         }
+
+        #process_api
     }
 }
 
@@ -336,7 +380,7 @@ fn system_example(ir: &Ir, names: &Names) -> Vec<String> {
 /// the module's name, unless a method of `System` has it.
 fn accessor(module: &Ident) -> String {
     let base = module.to_string().replace("r#", "");
-    if ["new", "run_cycles"].contains(&base.as_str()) {
+    if ["new", "run_cycles", "process"].contains(&base.as_str()) {
         format!("{base}_controller")
     } else {
         base

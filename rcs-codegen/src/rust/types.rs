@@ -53,11 +53,18 @@ pub(crate) fn module(
         let ids = &n.variants;
         let texts: Vec<&str> = e.variants.iter().map(|v| v.name.as_str()).collect();
         let serde = serde.into_iter();
+        let schema = super::schema::schema_impl(
+            names,
+            &quote!(#ty),
+            &format!("enum {}{{{}}}", e.name, texts.join(",")),
+            &[],
+        );
         quote! {
             #d
             #(#serde)*
             #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
             pub enum #ty { #(#variants),* }
+            #schema
             impl #ty {
                 /// The variant's name as written in the plans.
                 pub const fn name(self) -> &'static str {
@@ -93,12 +100,24 @@ pub(crate) fn module(
         let serde = serde
             .filter(|_| serde_derivable(ir, &Type::Buffer(rcs_dsl::ir::BufferTypeId(i as u32)), 0))
             .into_iter();
+        let structure = format!(
+            "buffer {}{{{}}}",
+            b.name,
+            b.fields
+                .iter()
+                .zip(&tys)
+                .map(|(f, t)| format!("{}:{}", f.name, t))
+                .collect::<Vec<_>>()
+                .join(",")
+        );
+        let schema = super::schema::schema_impl(names, &quote!(#ty), &structure, &tys);
         quote! {
             #d
             #(#serde)*
             #[derive(Clone, Copy, Debug, #derive PartialEq)]
             pub struct #ty { #(#fdocs pub #fields: #tys),* }
             #default_impl
+            #schema
         }
     });
     // Paths inside are `super::types::X`, which resolves from here too.

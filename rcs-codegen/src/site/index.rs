@@ -68,14 +68,22 @@ pub(super) fn index_page(site: &Site, svgs: &Svgs, placed: &[Placed]) -> String 
 pub(super) fn controllers_table(ir: &Ir, prefix: &str, members: &[usize]) -> String {
     let mut out = String::new();
     out.push_str("<h3>Controllers</h3>\n<table>\n<tr><th>controller</th><th>title</th><th>CPU</th><th>supervisor</th><th>plans</th></tr>\n");
+    // With several processes, the CPU column names the process too.
+    let distributed = rcs_dsl::placement::Placement::of(ir).is_distributed();
     for &ci in members {
         let c = &ir.controllers[ci];
         let cpu = ir
             .schedule
             .iter()
             .find(|cpu| cpu.order.iter().any(|o| o.index() == ci))
-            .map(|cpu| cpu.name.as_str())
-            .unwrap_or("—");
+            .map(|cpu| {
+                if distributed {
+                    format!("{} (process {})", cpu.name, ir.process_of(cpu))
+                } else {
+                    cpu.name.clone()
+                }
+            })
+            .unwrap_or_else(|| "—".into());
         let sup = match c.supervisor {
             Some(s) => {
                 let s = ir.controller(s);
@@ -100,7 +108,7 @@ pub(super) fn controllers_table(ir: &Ir, prefix: &str, members: &[usize]) -> Str
             ctrl_page(c),
             esc(&c.name),
             esc(c.title.as_deref().unwrap_or("")),
-            esc(cpu),
+            esc(&cpu),
             plans.join(" ")
         );
     }

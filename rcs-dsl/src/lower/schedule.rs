@@ -24,6 +24,8 @@ pub(super) fn lower_schedule(ir: &Ir, m: &Manifest, diags: &mut Diagnostics) -> 
             name: "main".to_string(),
             period_ns: DEFAULT_PERIOD_NS,
             order,
+            process: None,
+            inputs: Vec::new(),
         }];
     };
     let mut placed: Vec<Option<Span>> = vec![None; ir.controllers.len()];
@@ -71,6 +73,8 @@ pub(super) fn lower_schedule(ir: &Ir, m: &Manifest, diags: &mut Diagnostics) -> 
             name: spec.name.clone(),
             period_ns: spec.period_ns,
             order,
+            process: spec.process.as_ref().map(|p| p.0.clone()),
+            inputs: Vec::new(),
         });
     }
     let missing: Vec<&str> = ir
@@ -102,6 +106,7 @@ pub(super) fn lower_schedule(ir: &Ir, m: &Manifest, diags: &mut Diagnostics) -> 
             .with_help("list every controller exactly once across all CPUs' `order`"),
         );
     }
+    crate::placement::lower_inputs(ir, specs, &mut cpus, diags);
     cpus
 }
 

@@ -1,0 +1,44 @@
+//! # The submarine in two processes: Global Memory over Zenoh
+//!
+//! The plan set in `plans/` is Appendix C's submarine (`plans/submarine`)
+//! with a manifest that places SM and PR in process `helm` and TB in
+//! process `engine`, beside the simulated turbine and ship that write the
+//! external inputs `turbine` and `ship`. build.rs generates it; the
+//! generated `System::process` starts one process's CPU and a Zenoh bridge
+//! that carries `TB.command`, `TB.status` and `ship` between the two
+//! (docs/distribution.md). PR has one row more than in `plans/submarine`:
+//! `E2: *2 when TB.stale_cycles > 30 -> Error(TURBINE_SILENT)`.
+//!
+//! ```text
+//! cargo run -p submarine-split-example --features zenoh -- helm     # terminal 1: SM + PR, orders TRANSIT(15)
+//! cargo run -p submarine-split-example --features zenoh -- engine   # terminal 2: TB + turbine and ship simulators
+//! ```
+//!
+//! `helm` listens on `tcp/127.0.0.1:7447` and `engine` connects to it
+//! (`--listen`/`--connect` change that). `helm` waits for TB's first status,
+//! orders `SM <- TRANSIT(speed)`, and prints a line whenever a status
+//! changes; `transit KNOTS` on its standard input orders again. Stop
+//! `engine` and PR's E2 fires 31 cycles after TB's last status; start it
+//! again and order again: the hierarchy recovers. `one-process` runs the same
+//! plan set with `System::new` in one process, flat out, for comparison.
+//!
+//! Everything lives in `split.rs`, behind this crate's feature `zenoh`
+//! (which turns on `rcs-runtime/zenoh`): a workspace build without it
+//! compiles nothing from Zenoh.
+
+#[cfg(feature = "zenoh")]
+mod split;
+
+fn main() -> std::process::ExitCode {
+    #[cfg(feature = "zenoh")]
+    {
+        split::main()
+    }
+    #[cfg(not(feature = "zenoh"))]
+    {
+        eprintln!(
+            "submarine-split: built without Zenoh; run `cargo run -p submarine-split-example --features zenoh -- helm`"
+        );
+        std::process::ExitCode::from(2)
+    }
+}

@@ -1,0 +1,421 @@
+//! The two processes of the split submarine and the one-process run (see
+//! the crate's docs in `main.rs`).
+
+use std::io::BufRead;
+use std::process::ExitCode;
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use rcs_runtime::{BridgeConfig, Heartbeat, StatusBuffer, Wait};
+
+/// The generated plan set: this binary uses only part of its API.
+#[allow(dead_code)]
+mod plans {
+    rcs_runtime::include_plans!("submarine_split");
+}
+
+use plans::submarine_split;
+use submarine_split::types::{Ship, ShipDirection, SpeedError, TurbineDrive, TurbineSensors};
+use submarine_split::{pr, sm, tb, Hooks, System};
+
+/// The split submarine with PR's hooks.
+type Sub = System<Propulsion>;
+
+const USAGE: &str = "usage: submarine-split helm|engine|one-process [--listen ENDPOINT] [--connect ENDPOINT] [--speed KNOTS] [--cycles N]
+
+  helm         SM and PR; listens on tcp/127.0.0.1:7447; orders SM <- TRANSIT(speed) once TB answers;
+               `transit KNOTS` on standard input orders again
+  engine       TB with the turbine and ship simulators; connects to tcp/127.0.0.1:7447
+  one-process  the whole hierarchy in this process, flat out, until AT_GOAL
+  --cycles N   stop after N cycles (default: run until killed; one-process: 2000)";
+
+/// The helm's endpoint, which the engine connects to.
+const DEFAULT_ENDPOINT: &str = "tcp/127.0.0.1:7447";
+
+// ---------------------------------------------------------------------------
+// PR's hooks and the simulated world (as in examples/submarine)
+
+/// PR's propulsion model: RPM per knot (the ship needs 10: 5 % low, so
+/// Appendix C's ±1 RPM loop has work to do), and its dead band in knots.
+#[derive(Debug, Clone, Copy)]
+struct Propulsion {
+    rpm_per_knot: f64,
+    dead_band: f64,
+}
+
+const PROPULSION: Propulsion = Propulsion {
+    rpm_per_knot: 9.5,
+    dead_band: 0.1,
+};
+
+impl pr::Hooks for Propulsion {
+    fn required_rpm(&mut self, _data: &pr::Data, speed: f64) -> f64 {
+        self.rpm_per_knot * speed
+    }
+
+    fn speed_error(&mut self, data: &pr::Data) -> SpeedError {
+        let pr::Command::Ahead { speed: ordered } = data.command else {
+            return SpeedError::At;
+        };
+        let error = data.reads.ship.speed - ordered;
+        if error < -self.dead_band {
+            SpeedError::Below
+        } else if error > self.dead_band {
+            SpeedError::Above
+        } else {
+            SpeedError::At
+        }
+    }
+}
+
+/// The turbine and the ship: first-order lags stepped once per cycle, with
+/// compressed time constants (seconds) so that a run takes a few seconds.
+#[derive(Debug, Clone, Copy, Default)]
+struct Plant {
+    rpm: f64,
+    speed: f64,
+}
+
+impl Plant {
+    fn step(&mut self, drive: TurbineDrive, dt: f64) {
+        let lag = |tau: f64| 1.0 - (-dt / tau).exp();
+        let (target, tau) = if drive.engaged {
+            (drive.rpm_setpoint, 0.05)
+        } else {
+            (0.0, 2.0)
+        };
+        self.rpm += (target - self.rpm) * lag(tau);
+        self.speed += (0.1 * self.rpm - self.speed) * lag(0.05);
+    }
+
+    fn ship(&self) -> Ship {
+        let direction = if self.speed > 0.01 {
+            ShipDirection::Ahead
+        } else if self.speed < -0.01 {
+            ShipDirection::Backward
+        } else {
+            ShipDirection::Stopped
+        };
+        Ship {
+            direction,
+            speed: self.speed,
+        }
+    }
+
+    fn turbine(&self) -> TurbineSensors {
+        TurbineSensors { rpm: self.rpm }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Options
+
+#[derive(Debug, Clone)]
+struct Options {
+    role: String,
+    listen: Option<String>,
+    connect: Option<String>,
+    speed: f64,
+    cycles: Option<u64>,
+}
+
+impl Options {
+    fn parse(args: impl IntoIterator<Item = String>) -> Result<Option<Self>, String> {
+        let mut args = args.into_iter();
+        let role = match args.next() {
+            None => return Err("which process? helm, engine or one-process".into()),
+            Some(a) if a == "-h" || a == "--help" => return Ok(None),
+            Some(a) => a,
+        };
+        let mut opts = Options {
+            role,
+            listen: None,
+            connect: None,
+            speed: 15.0,
+            cycles: None,
+        };
+        while let Some(arg) = args.next() {
+            let mut value = || args.next().ok_or(format!("{arg} needs a value"));
+            match arg.as_str() {
+                "--listen" => opts.listen = Some(value()?),
+                "--connect" => opts.connect = Some(value()?),
+                "--speed" => {
+                    let v = value()?;
+                    opts.speed = v
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|s| s.is_finite() && *s > 0.0)
+                        .ok_or(format!("--speed: `{v}` is not a positive number of knots"))?;
+                }
+                "--cycles" => {
+                    let v = value()?;
+                    opts.cycles = Some(
+                        v.parse::<u64>()
+                            .map_err(|_| format!("--cycles: `{v}` is not a number of cycles"))?,
+                    );
+                }
+                other => return Err(format!("unexpected argument `{other}`")),
+            }
+        }
+        Ok(Some(opts))
+    }
+
+    fn bridge(&self) -> BridgeConfig {
+        let mut c = BridgeConfig::new("submarine_split", &self.role);
+        let (listen, connect) = match self.role.as_str() {
+            "helm" => (
+                Some(self.listen.as_deref().unwrap_or(DEFAULT_ENDPOINT)),
+                self.connect.as_deref(),
+            ),
+            _ => (
+                self.listen.as_deref(),
+                Some(self.connect.as_deref().unwrap_or(DEFAULT_ENDPOINT)),
+            ),
+        };
+        if let Some(l) = listen {
+            c = c.listen(l);
+        }
+        if let Some(e) = connect {
+            c = c.connect(e);
+        }
+        c
+    }
+}
+
+pub(crate) fn main() -> ExitCode {
+    let opts = match Options::parse(std::env::args().skip(1)) {
+        Ok(Some(opts)) => opts,
+        Ok(None) => {
+            println!("{USAGE}");
+            return ExitCode::SUCCESS;
+        }
+        Err(msg) => {
+            eprintln!("submarine-split: {msg}\n{USAGE}");
+            return ExitCode::from(2);
+        }
+    };
+    let result = match opts.role.as_str() {
+        "helm" => helm(&opts),
+        "engine" => engine(&opts),
+        "one-process" => one_process(&opts),
+        other => Err(format!("unknown process `{other}`")),
+    };
+    match result {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::FAILURE,
+        Err(e) => {
+            eprintln!("submarine-split: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Display
+
+/// `SM=VERB/STATE/STATUS PR=VERB/STATE/STATUS` for the controllers this
+/// process runs.
+fn statuses(system: &Sub) -> String {
+    let mut parts = Vec::new();
+    if let Some(c) = system.sm() {
+        parts.push(format!(
+            "SM={}/{}/{}",
+            c.verb_name().unwrap_or("-"),
+            c.state_name().unwrap_or("-"),
+            c.status().map_or("?", sm::Status::name)
+        ));
+    }
+    if let Some(c) = system.pr() {
+        parts.push(format!(
+            "PR={}/{}/{}",
+            c.verb_name().unwrap_or("-"),
+            c.state_name().unwrap_or("-"),
+            c.status().map_or("?", pr::Status::name)
+        ));
+    }
+    if let Some(c) = system.tb() {
+        parts.push(format!(
+            "TB={}/{}/{}",
+            c.verb_name().unwrap_or("-"),
+            c.state_name().unwrap_or("-"),
+            c.status().map_or("?", tb::Status::name)
+        ));
+    }
+    parts.join(" ")
+}
+
+/// Whether PR reports AT_GOAL.
+fn at_goal(system: &Sub) -> bool {
+    system.pr().and_then(pr::Controller::status) == Some(pr::Status::AtGoal)
+}
+
+/// The bridge's refusals, once each (a schema mismatch means the other
+/// process was built from other plans).
+fn report_bridge_errors(bridge: &rcs_runtime::Bridge, shown: &mut usize) {
+    let errors = bridge.errors();
+    for e in errors.iter().skip(*shown) {
+        println!("bridge error: {e}");
+    }
+    *shown = (*shown).max(errors.len());
+}
+
+// ---------------------------------------------------------------------------
+// The processes
+
+/// SM and PR: wait for TB, order TRANSIT, print status changes; orders from
+/// standard input. Returns whether PR reached AT_GOAL at least once.
+fn helm(opts: &Options) -> Result<bool, String> {
+    let (mut system, bridge) =
+        Sub::process("helm", opts.bridge(), Hooks { pr: PROPULSION }).map_err(|e| e.to_string())?;
+    let tb_status = system
+        .gm
+        .reader::<StatusBuffer>(&rcs_runtime::status_buffer_name(tb::NAME))
+        .map_err(|e| e.to_string())?;
+    println!("helm: waiting for the engine process");
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while tb_status.generation() == 0 {
+        if Instant::now() > deadline {
+            return Err("the engine process did not answer within 120 s".into());
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    println!("helm: engine answered");
+
+    // Orders typed on standard input, read on a thread of their own.
+    let (orders, order_rx) = mpsc::channel::<f64>();
+    std::thread::spawn(move || {
+        for line in std::io::stdin().lock().lines().map_while(Result::ok) {
+            let mut words = line.split_whitespace();
+            if let (Some("transit"), Some(Ok(kn))) = (words.next(), words.next().map(str::parse)) {
+                if orders.send(kn).is_err() {
+                    break;
+                }
+            }
+        }
+    });
+
+    let order = |system: &mut Sub, speed: f64| {
+        system.operators.sm.command(sm::Command::Transit { speed });
+        println!("order SM <- TRANSIT(speed: {speed:.2})");
+    };
+    order(&mut system, opts.speed);
+    let period = system
+        .executives
+        .first()
+        .map_or(Duration::from_millis(30), |e| e.period());
+    let mut heartbeat = Heartbeat::new(period, Wait::default());
+    let mut last = String::new();
+    let mut reached = false;
+    let mut goal_seen = false;
+    let mut errors_shown = 0;
+    let mut cycle = 0u64;
+    while opts.cycles.is_none_or(|n| cycle < n) {
+        heartbeat.wait();
+        if let Ok(speed) = order_rx.try_recv() {
+            order(&mut system, speed);
+            goal_seen = false;
+        }
+        system.run_cycles(1);
+        let now = statuses(&system);
+        // PR's watchdog count on TB: cycles since TB's status last changed.
+        let stale = system.pr().map_or(0, |c| c.data().subs.tb.stale_cycles);
+        if now != last {
+            println!("cycle {cycle} {now} tb_stale={stale}");
+            last = now;
+        }
+        if at_goal(&system) && !goal_seen {
+            goal_seen = true;
+            reached = true;
+            println!("goal {}", statuses(&system));
+        }
+        report_bridge_errors(&bridge, &mut errors_shown);
+        cycle += 1;
+    }
+    Ok(reached)
+}
+
+/// TB with the simulated turbine and ship, on its own heartbeat.
+fn engine(opts: &Options) -> Result<bool, String> {
+    let (mut system, bridge) = Sub::process("engine", opts.bridge(), Hooks { pr: PROPULSION })
+        .map_err(|e| e.to_string())?;
+    let period = system
+        .executives
+        .first()
+        .map_or(Duration::from_millis(30), |e| e.period());
+    let dt = period.as_secs_f64();
+    let mut plant = Plant::default();
+    let (Some(mut ship), Some(mut turbine)) =
+        (system.inputs.ship.take(), system.inputs.turbine.take())
+    else {
+        return Err("the manifest places `ship` and `turbine` in another process".into());
+    };
+    ship.write(plant.ship(), 0);
+    turbine.write(plant.turbine(), 0);
+    println!("engine: running");
+    let mut heartbeat = Heartbeat::new(period, Wait::default());
+    let mut last = String::new();
+    let mut errors_shown = 0;
+    let mut cycle = 0u64;
+    while opts.cycles.is_none_or(|n| cycle < n) {
+        heartbeat.wait();
+        system.run_cycles(1);
+        plant.step(system.outputs.drive.read().value, dt);
+        ship.write(plant.ship(), cycle + 1);
+        turbine.write(plant.turbine(), cycle + 1);
+        let now = statuses(&system);
+        if now != last {
+            println!("cycle {cycle} {now}");
+            last = now;
+        }
+        report_bridge_errors(&bridge, &mut errors_shown);
+        cycle += 1;
+    }
+    Ok(true)
+}
+
+/// The same hierarchy and simulators in one process, flat out: prints the
+/// same `goal` line as `helm` when PR first reports AT_GOAL.
+fn one_process(opts: &Options) -> Result<bool, String> {
+    let mut system = Sub::new(Hooks { pr: PROPULSION }).map_err(|e| e.to_string())?;
+    let period = system
+        .executives
+        .first()
+        .map_or(Duration::from_millis(30), |e| e.period());
+    let dt = period.as_secs_f64();
+    let mut plant = Plant::default();
+    let (Some(ship), Some(turbine)) = (system.inputs.ship.as_mut(), system.inputs.turbine.as_mut())
+    else {
+        return Err("`System::new` holds every input".into());
+    };
+    ship.write(plant.ship(), 0);
+    turbine.write(plant.turbine(), 0);
+    system
+        .operators
+        .sm
+        .command(sm::Command::Transit { speed: opts.speed });
+    for cycle in 0..opts.cycles.unwrap_or(2_000) {
+        system.run_cycles(1);
+        plant.step(system.outputs.drive.read().value, dt);
+        if let (Some(ship), Some(turbine)) =
+            (system.inputs.ship.as_mut(), system.inputs.turbine.as_mut())
+        {
+            ship.write(plant.ship(), cycle + 1);
+            turbine.write(plant.turbine(), cycle + 1);
+        }
+        if at_goal(&system) {
+            println!("goal {}", statuses_of_helm(&system));
+            return Ok(true);
+        }
+    }
+    Ok(false)
+}
+
+/// `statuses` restricted to the helm's controllers (SM and PR), for
+/// comparing a one-process run with the helm process.
+fn statuses_of_helm(system: &Sub) -> String {
+    statuses(system)
+        .split(' ')
+        .filter(|p| !p.starts_with("TB="))
+        .collect::<Vec<_>>()
+        .join(" ")
+}

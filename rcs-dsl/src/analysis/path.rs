@@ -318,6 +318,13 @@ impl PlanAnalysis<'_> {
         Some(self.pins(&scene, prefix, wait))
     }
 
+    /// The waits worth trying after `prefix` (see `waits`); `None` when
+    /// `prefix` does not replay.
+    pub(super) fn waits_after(&self, prefix: &Run) -> Option<Vec<u32>> {
+        let scene = self.scene(prefix)?;
+        Some(self.waits(&scene, prefix.steps.is_empty()))
+    }
+
     /// What the interpreter holds after `run`: a fresh controller for the
     /// empty run.
     fn scene(&self, run: &Run) -> Option<Scene> {

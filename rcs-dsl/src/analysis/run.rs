@@ -68,6 +68,10 @@ pub enum Expect {
     /// the plan in its state: an oscillation, or with one row a command
     /// storm.
     Repeats { rows: Vec<Firing> },
+    /// No row fires until the last cycle, where an index by a value falls
+    /// outside its array and the plan ends with `INDEX_RANGE`: in `row`'s
+    /// jobs, or (`None`) in a condition, no row firing.
+    IndexRange { row: Option<String> },
 }
 
 impl Default for Expect {
@@ -89,15 +93,26 @@ impl Expect {
     fn fired_on(&self, i: u32, cycles: u32) -> Option<&str> {
         match self {
             Expect::Fires { row, .. } => (i + 1 == cycles).then_some(row.as_str()),
+            Expect::IndexRange { row } => row.as_deref().filter(|_| i + 1 == cycles),
             Expect::Stays { .. } => None,
             Expect::Repeats { rows } if rows.is_empty() => None,
             Expect::Repeats { rows } => Some(rows[i as usize % rows.len()].row.as_str()),
         }
     }
 
-    /// The row fired on the last cycle and the state after it.
-    fn last(&self, cycles: u32) -> (Option<&str>, &str) {
+    /// The row fired on the last cycle and the state after it (`None`:
+    /// the plan ended with `INDEX_RANGE`, in no state a scenario names).
+    fn last(&self, cycles: u32) -> (Option<&str>, Option<&str>) {
+        let (fired, state) = match self {
+            Expect::IndexRange { row } => return (row.as_deref(), None),
+            _ => self.last_in_state(cycles),
+        };
+        (fired, Some(state))
+    }
+
+    fn last_in_state(&self, cycles: u32) -> (Option<&str>, &str) {
         match self {
+            Expect::IndexRange { .. } => (None, "S0"),
             Expect::Fires { row, state } => (Some(row), state),
             Expect::Stays { state } => (None, state),
             Expect::Repeats { rows } => {
@@ -162,7 +177,12 @@ pub fn scenario_text(run: &Run, name: &str, about: &str) -> Result<String, Strin
     #[derive(Serialize)]
     struct ExpectFile<'a> {
         fired: &'a str,
-        state: &'a str,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        state: Option<&'a str>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        status: Option<&'a str>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        error: Option<&'a str>,
     }
     let command = if run.params.is_empty() {
         Json::String(run.command.clone())
@@ -191,6 +211,7 @@ pub fn scenario_text(run: &Run, name: &str, about: &str) -> Result<String, Strin
         .enumerate()
         .map(|(i, (s, subordinates))| {
             let (fired, state) = s.expect.last(s.cycles);
+            let ended = matches!(s.expect, Expect::IndexRange { .. });
             StepFile {
                 command: (i == 0).then(|| command.clone()),
                 reads: &s.reads,
@@ -200,6 +221,8 @@ pub fn scenario_text(run: &Run, name: &str, about: &str) -> Result<String, Strin
                 expect: ExpectFile {
                     fired: fired.unwrap_or("none"),
                     state,
+                    status: ended.then_some("ERROR"),
+                    error: ended.then_some("INDEX_RANGE"),
                 },
             }
         })

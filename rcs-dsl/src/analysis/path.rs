@@ -285,8 +285,17 @@ impl PlanAnalysis<'_> {
                 Leaf::Param(p, steps) if first => {
                     *at_path_mut(params.get_mut(p.index())?, steps)? = v.clone();
                 }
-                // Runs do not set subordinates' status fields yet: such a
-                // witness gets no run (and so no finding leans on one).
+                // A whole status field; a part of one (a field of a
+                // buffer it holds) a scenario sets only with the rest.
+                Leaf::SubField(x, f, steps) if steps.is_empty() => {
+                    let sub = ir.controller(*x);
+                    let var = sub.vars.get(f.index())?;
+                    let value = json_of(ir, &var.ty, v)?;
+                    step.status_fields
+                        .entry(sub.name.clone())
+                        .or_default()
+                        .insert(var.name.clone(), value);
+                }
                 Leaf::SubField(..) => return None,
                 _ => {}
             }

@@ -11,9 +11,10 @@
 //! sequence of rows fires over and over ([`Expect::Repeats`]); a command
 //! storm is the same with one row ([`RunStep::fires_each_cycle`]).
 //!
-//! A run holds only what a scenario can set: `reads` buffers, hook results
-//! and subordinate statuses. Vars, counters and `new_command` follow from
-//! the steps; a run that needs other values of them is not built. Values
+//! A run holds only what a scenario can set: `reads` buffers, hook results,
+//! subordinate statuses and their status fields. Vars, counters and
+//! `new_command` follow from the steps; a run that needs other values of
+//! them is not built. Values
 //! are kept as a scenario writes them (JSON), so the diagnostic's JSON, the
 //! scenario file and the replay read the same thing.
 
@@ -49,6 +50,10 @@ pub struct RunStep {
     /// Subordinate statuses (echoing the last command sent), by name.
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub subordinates: BTreeMap<String, String>,
+    /// Subordinates' status fields, by subordinate then field name: each
+    /// published from this step on, until set again.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub status_fields: BTreeMap<String, BTreeMap<String, Json>>,
     pub cycles: u32,
     pub expect: Expect,
 }
@@ -170,7 +175,7 @@ pub fn scenario_text(run: &Run, name: &str, about: &str) -> Result<String, Strin
         #[serde(skip_serializing_if = "BTreeMap::is_empty")]
         hooks: &'a BTreeMap<String, Json>,
         #[serde(skip_serializing_if = "BTreeMap::is_empty")]
-        subordinates: &'a BTreeMap<String, String>,
+        subordinates: BTreeMap<String, Json>,
         cycles: u32,
         expect: ExpectFile<'a>,
     }
@@ -212,6 +217,27 @@ pub fn scenario_text(run: &Run, name: &str, about: &str) -> Result<String, Strin
         .map(|(i, (s, subordinates))| {
             let (fired, state) = s.expect.last(s.cycles);
             let ended = matches!(s.expect, Expect::IndexRange { .. });
+            let mut subordinates: BTreeMap<String, Json> = subordinates
+                .iter()
+                .map(|(x, status)| (x.clone(), Json::String(status.clone())))
+                .collect();
+            // A subordinate whose status fields the step sets: its status
+            // in force (or, never set, the scene's start: NOT_READY with
+            // echo 0) and the fields, in one setting.
+            for (x, fields) in &s.status_fields {
+                let mut m = serde_json::Map::new();
+                match subordinates.get(x) {
+                    Some(status) => {
+                        m.insert("status".into(), status.clone());
+                    }
+                    None => {
+                        m.insert("status".into(), Json::String("NOT_READY".into()));
+                        m.insert("echo".into(), Json::from(0));
+                    }
+                }
+                m.extend(fields.clone());
+                subordinates.insert(x.clone(), Json::Object(m));
+            }
             StepFile {
                 command: (i == 0).then(|| command.clone()),
                 reads: &s.reads,

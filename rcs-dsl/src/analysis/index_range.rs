@@ -1,5 +1,7 @@
 //! Stage 3a: where a plan indexes an array by a run-time value (`a[i]` in
-//! a condition, a job, an assignment target), whether the index can fall
+//! a condition, a job, an assignment target, or the controller's `pre`,
+//! met on every cycle before the rows; not yet `post`, which runs only
+//! when nothing before it ended the cycle), whether the index can fall
 //! outside the array on a cycle the interpreter gets there — the question
 //! behind the `index_range` lint.
 //!
@@ -30,12 +32,16 @@ use crate::ir::{
 };
 use crate::source::Span;
 
-/// One index by a run-time value in a row.
+/// One index by a run-time value in a row, or in `pre`.
 #[derive(Clone, Debug)]
 pub struct Site {
+    /// The row it is in (unused for `pre`).
     pub row: usize,
     /// The job it is in; `None`: the row's condition.
     pub job: Option<usize>,
+    /// In the controller's `pre` block (job `job`), not in a row: met at
+    /// the start of every cycle, before any row.
+    pub pre: bool,
     /// The indexed expression or assignment target, as written.
     pub array: String,
     pub index: Expr,
@@ -86,48 +92,79 @@ pub(super) fn sites(ir: &Ir, ctrl: &Controller, plan: &Plan, terms: &mut Terms) 
             in_job(ir, ctrl, &printer, job, &mut met);
             units.push((Some(k), met));
         }
-        // For a job's index: the condition's indices, all in range (the
-        // row fired), then the jobs' before it.
-        let mut earlier: Vec<Option<Formula>> = Vec::new();
-        for (job, met) in units {
-            let outs: Vec<Option<Formula>> = met
-                .iter()
-                .map(|m| out_formula(terms, ctrl, &assigned, &m.index, m.len))
-                .collect();
-            for (m, o) in met.iter().zip(&outs) {
-                // Every other index of the same atom or job is in range
-                // too: which of them the interpreter meets first is not
-                // modelled, so none may be out.
-                let others = outs.iter().filter(|x| !std::ptr::eq(*x, o));
-                let in_range: Option<Vec<Formula>> = earlier
-                    .iter()
-                    .chain(others)
-                    .map(|x| x.clone().map(|f| Formula::Not(Box::new(f))))
-                    .collect();
-                let before = match (job, &m.guard, in_range) {
-                    (_, Some(g), Some(mut ins)) => {
-                        ins.extend(g.iter().cloned());
-                        Some(ins)
-                    }
-                    _ => None,
-                };
-                out.push(Site {
-                    row: r,
-                    job,
-                    array: m.array.clone(),
-                    index: m.index.clone(),
-                    len: m.len,
-                    span: m.span,
-                    out: o.clone(),
-                    before,
-                });
-            }
-            // A job's indices are all in range for a later job to run; a
-            // condition's, for the row to fire at all.
-            earlier.extend(outs);
-        }
+        add_sites(terms, ctrl, &assigned, r, false, units, &mut out);
+    }
+    // `pre` runs on every cycle of every plan: its indices go with the
+    // controller's first plan only, so that each is reported once.
+    let first = ctrl.plans.first().is_some_and(|p0| std::ptr::eq(p0, plan));
+    if let (Some(pre), true) = (&ctrl.pre, first) {
+        let units = pre
+            .jobs
+            .iter()
+            .enumerate()
+            .map(|(k, job)| {
+                let mut met = Vec::new();
+                in_job(ir, ctrl, &printer, job, &mut met);
+                (Some(k), met)
+            })
+            .collect();
+        add_sites(terms, ctrl, &assigned, 0, true, units, &mut out);
     }
     out
+}
+
+/// The sites of one row (or of `pre`), from the indices each of its units
+/// (its condition, then each job) meets.
+fn add_sites(
+    terms: &mut Terms,
+    ctrl: &Controller,
+    assigned: &[crate::ir::VarId],
+    row: usize,
+    pre: bool,
+    units: Vec<(Option<usize>, Vec<Met>)>,
+    out: &mut Vec<Site>,
+) {
+    // For a job's index: the condition's indices, all in range (the row
+    // fired), then the jobs' before it.
+    let mut earlier: Vec<Option<Formula>> = Vec::new();
+    for (job, met) in units {
+        let outs: Vec<Option<Formula>> = met
+            .iter()
+            .map(|m| out_formula(terms, ctrl, assigned, &m.index, m.len))
+            .collect();
+        for (m, o) in met.iter().zip(&outs) {
+            // Every other index of the same atom or job is in range too:
+            // which of them the interpreter meets first is not modelled,
+            // so none may be out.
+            let others = outs.iter().filter(|x| !std::ptr::eq(*x, o));
+            let in_range: Option<Vec<Formula>> = earlier
+                .iter()
+                .chain(others)
+                .map(|x| x.clone().map(|f| Formula::Not(Box::new(f))))
+                .collect();
+            let before = match (&m.guard, in_range) {
+                (Some(g), Some(mut ins)) => {
+                    ins.extend(g.iter().cloned());
+                    Some(ins)
+                }
+                _ => None,
+            };
+            out.push(Site {
+                row,
+                job,
+                pre,
+                array: m.array.clone(),
+                index: m.index.clone(),
+                len: m.len,
+                span: m.span,
+                out: o.clone(),
+                before,
+            });
+        }
+        // A job's indices are all in range for a later job to run; a
+        // condition's, for the row to fire at all.
+        earlier.extend(outs);
+    }
 }
 
 /// `i < 0 || i >= LEN` for an index the analysis models exactly.
@@ -332,6 +369,21 @@ impl PlanAnalysis<'_> {
             let (Some(out), Some(before)) = (&site.out, &site.before) else {
                 continue;
             };
+            if site.pre {
+                // The command's first cycle: `pre` runs before any row.
+                let f = Formula::And(before.iter().chain([out]).cloned().collect());
+                let Some(Some(prefix)) = paths.first() else {
+                    continue;
+                };
+                if let Some((witness, run)) = self.index_run(prefix, site, StateId::S0, &f) {
+                    found.push(OutOfRange {
+                        site: i,
+                        witness,
+                        run,
+                    });
+                }
+                continue;
+            }
             for (s, prefix) in paths.iter().enumerate() {
                 let state = StateId(s as u32);
                 let Some(prefix) = prefix else { continue };
@@ -424,7 +476,7 @@ impl PlanAnalysis<'_> {
         f: &Formula,
     ) -> Option<(Witness, Run)> {
         let expect = Expect::IndexRange {
-            row: site.job.map(|_| row_name(&self.plan.rows[site.row])),
+            row: (site.job.is_some() && !site.pre).then(|| row_name(&self.plan.rows[site.row])),
         };
         for wait in self.waits_after(prefix)? {
             let fixed = self.pins_after(prefix, wait)?;

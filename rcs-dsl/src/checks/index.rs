@@ -28,6 +28,10 @@ pub(crate) fn check_index_range(
             .get(found.witness.state.index())
             .map_or("?", |s| s.name.as_str());
         let (where_, then) = match site.job {
+            _ if site.pre => (
+                "",
+                "`pre` meets this index on the command's first cycle: no row fires, and the plan ends with the error INDEX_RANGE",
+            ),
             Some(_) => (
                 "in a job",
                 "the row fires, its jobs stop at this index, and the plan ends with the error INDEX_RANGE",
@@ -43,14 +47,34 @@ pub(crate) fn check_index_range(
         } else {
             format!("`{index} < {len}`")
         };
-        let d = Diagnostic::lint(
-            Lint::IndexRange,
+        let message = if site.pre {
+            format!(
+                "`pre` of `{}` can index `{}` outside 0..{len}",
+                c.name, site.array
+            )
+        } else {
             format!(
                 "row {} of plan `{}` can index `{}` outside 0..{len} {where_}",
                 row.display_name(),
                 c.plan_title(p),
                 site.array,
-            ),
+            )
+        };
+        let last = len.saturating_sub(1);
+        let fix = if site.pre {
+            // `pre` has no condition: the index itself must stay inside.
+            let kept = if signed {
+                format!("clamp({index}, 0, {last})")
+            } else {
+                format!("min({index}, {last})")
+            };
+            format!("keep the index inside the array: `{kept}`")
+        } else {
+            format!("guard the row: {guard} in its condition, before the index is read")
+        };
+        let d = Diagnostic::lint(
+            Lint::IndexRange,
+            message,
             site.span,
             format!("`{index}` can be outside 0..{len} here"),
         )
@@ -58,9 +82,8 @@ pub(crate) fn check_index_range(
         .with_run(Some(found.run))
         .with_note(format!("with these inputs {then}"))
         .with_help(format!(
-            "guard the row: {guard} in its condition, before the index is read; \
-             or accept INDEX_RANGE as this plan's error with `#[allow(index_range)]`"
+            "{fix}; or accept INDEX_RANGE as the error with `#[allow(index_range)]`"
         ));
-        sink.lint(Some(c), Some(p), d);
+        sink.lint(Some(c), (!site.pre).then_some(p), d);
     }
 }

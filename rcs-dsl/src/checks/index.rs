@@ -20,7 +20,6 @@ pub(crate) fn check_index_range(
     let printer = crate::pretty::Printer::new(ir, c, Some(p));
     for found in an.out_of_range() {
         let site = &an.index_sites()[found.site];
-        let row = &p.rows[site.row];
         let index = printer.expr(&site.index);
         let len = site.len;
         let state = p
@@ -55,7 +54,9 @@ pub(crate) fn check_index_range(
         } else {
             format!(
                 "row {} of plan `{}` can index `{}` outside 0..{len} {where_}",
-                row.display_name(),
+                p.rows
+                    .get(site.row)
+                    .map_or_else(String::new, |r| r.display_name()),
                 c.plan_title(p),
                 site.array,
             )

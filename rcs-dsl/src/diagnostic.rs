@@ -196,6 +196,7 @@ impl Code {
             Code::Lint(Lint::StatusNeverReported) => {
                 "a supervisor waits for a status the subordinate never reports"
             }
+            Code::Lint(Lint::IndexRange) => "an index by a run-time value can fall outside its array",
             Code::EveryCycleDecision => {
                 "a `pre` or `post` block sends, reports or changes state: decisions belong in the rows"
             }

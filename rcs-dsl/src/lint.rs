@@ -23,10 +23,11 @@ pub enum Lint {
     Livelock,
     CommandEveryCycle,
     StatusNeverReported,
+    IndexRange,
 }
 
 impl Lint {
-    pub const ALL: [Lint; 14] = [
+    pub const ALL: [Lint; 15] = [
         Lint::RuleOfTen,
         Lint::ShadowedRow,
         Lint::UnreachableState,
@@ -41,6 +42,7 @@ impl Lint {
         Lint::Livelock,
         Lint::CommandEveryCycle,
         Lint::StatusNeverReported,
+        Lint::IndexRange,
     ];
 
     pub fn name(self) -> &'static str {
@@ -59,6 +61,7 @@ impl Lint {
             Lint::Livelock => "livelock",
             Lint::CommandEveryCycle => "command_every_cycle",
             Lint::StatusNeverReported => "status_never_reported",
+            Lint::IndexRange => "index_range",
         }
     }
 

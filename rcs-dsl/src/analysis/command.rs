@@ -163,7 +163,7 @@ impl PlanAnalysis<'_> {
     /// `S0` "any cycle" includes the first, so a row back to `S0`, whose
     /// entry rows need a new command, is still reported.
     pub fn hangs(&self) -> Vec<Hang> {
-        if !self.analysed() {
+        if !self.analysed_over_cycles() {
             return Vec::new();
         }
         let constants = self.constant_vars();
@@ -226,7 +226,7 @@ impl PlanAnalysis<'_> {
     /// condition but not with any case the state may be reached with.
     /// Only the command's parameters are pinned (every answer a proof).
     pub fn entry_bound_rows(&self) -> Vec<EntryBound> {
-        if !self.analysed() {
+        if !self.analysed_over_cycles() {
             return Vec::new();
         }
         let params = self.command_leaves();

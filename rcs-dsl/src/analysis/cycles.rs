@@ -58,7 +58,7 @@ pub struct CommandStorm {
 
 /// The livelocks of one plan, each reachable from the entry.
 pub fn livelocks(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<Livelock> {
-    if !an.analysed() {
+    if !an.analysed_over_cycles() {
         return Vec::new();
     }
     // No ring of states among the rows that can fire: nothing to walk.
@@ -196,7 +196,7 @@ pub fn livelocks(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<Livel
 /// The command storms of one plan: per row and subordinate, the first one
 /// a walk from the entry finds.
 pub fn command_storms(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<CommandStorm> {
-    if !an.analysed() {
+    if !an.analysed_over_cycles() {
         return Vec::new();
     }
     // A row can send on two cycles in a row only if it leaves the plan in

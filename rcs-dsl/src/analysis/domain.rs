@@ -10,7 +10,8 @@
 //! A witness search tries the representatives and a few more concrete
 //! values for leaves that opaque atoms read (the numbers those atoms
 //! mention and their neighbours, 0, ±1, the bounds), since an opaque atom
-//! has no cells of its own.
+//! has no cells of its own. An array an index by a value reads gets arrays
+//! of equal elements, one per value tried for an element.
 
 use super::eval::eval;
 use super::terms::{Leaf, Terms};
@@ -247,6 +248,19 @@ fn extra(ir: &Ir, ty: &Type, numbers: &[f64]) -> Vec<Value> {
             }
             vs.into_iter()
                 .map(|v| Value::Float(crate::arith::round(v, *t)))
+                .collect()
+        }
+        // An array read by a run-time index: every element alike, each
+        // value tried for one element (the witness does not pick which).
+        Type::Array(e, n) => {
+            let mut vs = vec![crate::interp::zero(ir, e)];
+            for v in extra(ir, e, numbers) {
+                if !vs.contains(&v) {
+                    vs.push(v);
+                }
+            }
+            vs.into_iter()
+                .map(|v| Value::Array(vec![v; *n as usize]))
                 .collect()
         }
         other => cells_of(ir, other, &[]),

@@ -1,6 +1,7 @@
 //! An atom's value on concrete leaf values, through the language's one
 //! arithmetic ([`crate::arith`]), as the interpreter and the generated code
-//! compute it.
+//! compute it. An index by a value outside its array gives no value (the
+//! plan ends with `INDEX_RANGE` there instead).
 
 use super::terms::{as_leaf, Leaf};
 use crate::arith;
@@ -49,6 +50,18 @@ pub fn eval(e: &Expr, leaf: &dyn Fn(&Leaf) -> Option<Value>) -> Option<Value> {
                 .collect::<Option<Vec<Value>>>()?;
             let ty = args.first().map_or(&e.ty, |a| &a.ty);
             crate::builtin::apply(*b, &values, ty)
+        }
+        // Out of range, the interpreter ends the plan with INDEX_RANGE: no
+        // value, so a condition that meets it is neither true nor false.
+        ExprKind::IndexBy(base, i) => {
+            let Value::Array(mut es) = eval(base, leaf)? else {
+                return None;
+            };
+            let i = match eval(i, leaf)? {
+                Value::Int(i) => usize::try_from(i).ok().filter(|i| *i < es.len())?,
+                _ => return None,
+            };
+            es.swap_remove(i)
         }
         // Every other kind is a leaf (handled above).
         _ => return None,

@@ -49,6 +49,7 @@ pub mod command;
 pub mod cycles;
 pub mod domain;
 pub mod eval;
+pub mod index_range;
 pub mod path;
 pub mod run;
 pub mod search;
@@ -123,6 +124,19 @@ pub struct PlanAnalysis<'ir> {
     /// The plan is larger than [`MAX_ANALYSED`]: every question is
     /// answered "unknown" at once (the checks then say nothing).
     skipped: bool,
+    /// A condition indexes by a run-time value: it may end the plan with
+    /// `INDEX_RANGE` instead of matching or not. Proofs that a row never
+    /// matches or fires still hold (an opaque atom is a free boolean, and
+    /// a row fires only on conditions evaluated without error); witnesses
+    /// evaluate `&&` and `||` in the interpreter's order; the questions
+    /// that "no row matches" (waits, stalls, hangs, walks over several
+    /// cycles) are not answered.
+    indexed: bool,
+    /// The leaves the conditions read come first; those after them only
+    /// the questions of [`index_range`] read.
+    condition_leaves: usize,
+    /// The indices by a run-time value of the rows ([`index_range`]).
+    sites: Vec<index_range::Site>,
     /// Proofs asked before, by question: the checks ask some twice.
     proved: std::cell::RefCell<std::collections::BTreeMap<Question, bool>>,
 }
@@ -150,6 +164,13 @@ impl<'ir> PlanAnalysis<'ir> {
                 Condition::Otherwise => None,
             })
             .collect();
+        let condition_leaves = terms.leaves.len();
+        let skipped = plan.rows.len() > MAX_ANALYSED || plan.states.len() > MAX_ANALYSED;
+        let sites = if skipped {
+            Vec::new()
+        } else {
+            index_range::sites(ir, ctrl, plan, &mut terms)
+        };
         let cells = domain::cells(ir, &terms);
         let tables = domain::tables(&terms, &cells);
         PlanAnalysis {
@@ -162,24 +183,29 @@ impl<'ir> PlanAnalysis<'ir> {
             tables,
             candidates: std::cell::OnceCell::new(),
             new_command,
-            // A condition that indexes by a value can end the plan with
-            // INDEX_RANGE instead of matching or not; until the questions
-            // model that outcome, such a plan is left alone like a big one.
-            skipped: plan.rows.len() > MAX_ANALYSED
-                || plan.states.len() > MAX_ANALYSED
-                || plan.rows.iter().any(|r| match &r.cond {
-                    Condition::When(e) => e.indexes_by_value(),
-                    Condition::Otherwise => false,
-                }),
+            skipped,
+            indexed: plan.rows.iter().any(|r| match &r.cond {
+                Condition::When(e) => e.indexes_by_value(),
+                Condition::Otherwise => false,
+            }),
+            condition_leaves,
+            sites,
             proved: Default::default(),
         }
     }
 
     /// Whether the analysis answers questions about this plan: plans of
-    /// more than [`MAX_ANALYSED`] rows or states, and plans with a condition
-    /// that indexes by a run-time value, are left alone.
+    /// more than [`MAX_ANALYSED`] rows or states are left alone.
     pub fn analysed(&self) -> bool {
         !self.skipped
+    }
+
+    /// Whether it also answers the questions over several cycles and
+    /// those that no row matches (hangs, stalls, walks): not for a plan
+    /// whose conditions index by a value, where a cycle on which no row
+    /// matches may instead end the plan with `INDEX_RANGE`.
+    pub fn analysed_over_cycles(&self) -> bool {
+        !self.skipped && !self.indexed
     }
 
     /// Whether row `row` can match at all, judged by its own `from` and
@@ -211,7 +237,7 @@ impl<'ir> PlanAnalysis<'ir> {
     /// `None` when some row may match (or the analysis cannot tell, or no
     /// condition reads `sub`'s status).
     pub fn stalls_in(&self, state: StateId, sub: CtrlId, status: StatusId) -> Option<Witness> {
-        if self.skipped {
+        if !self.analysed_over_cycles() {
             return None;
         }
         let leaf = self.terms.find(&Leaf::SubStatus(sub))?;
@@ -224,7 +250,10 @@ impl<'ir> PlanAnalysis<'ir> {
         }
         let none = Formula::Not(Box::new(some_row));
         let candidates = self.candidates();
-        match Search::new(&self.terms, Mode::Witness, candidates, &[], &fixed).run(&none) {
+        match Search::new(&self.terms, Mode::Witness, candidates, &[], &fixed)
+            .in_order(self.indexed)
+            .run(&none)
+        {
             Outcome::Found(values) => Some(self.witness(&none, state, values)),
             Outcome::None | Outcome::Unknown => None,
         }
@@ -262,7 +291,7 @@ impl<'ir> PlanAnalysis<'ir> {
     /// The leaves that hold one value for the whole command, whatever it
     /// is: the command's parameters (a new command starts a new plan run).
     pub fn command_leaves(&self) -> Vec<LeafId> {
-        (0..self.terms.leaves.len())
+        (0..self.condition_leaves)
             .filter(|&l| matches!(self.terms.leaves[l].0, Leaf::Param(..)))
             .collect()
     }
@@ -317,6 +346,9 @@ impl<'ir> PlanAnalysis<'ir> {
         firings: &[(usize, StateId)],
         given: &[(LeafId, Value)],
     ) -> Answer {
+        if !self.analysed_over_cycles() {
+            return Answer::Unknown;
+        }
         let mut parts = Vec::new();
         for &(row, state) in firings {
             match self.fires(row, state) {
@@ -332,6 +364,9 @@ impl<'ir> PlanAnalysis<'ir> {
     /// waits), with the `given` leaves pinned: no row covering `state`
     /// matches, and the plan has no `otherwise`.
     pub fn can_idle_given(&self, state: StateId, given: &[(LeafId, Value)]) -> Answer {
+        if !self.analysed_over_cycles() {
+            return Answer::Unknown;
+        }
         let Some(any) = self.conditions_covering(state) else {
             return Answer::Never;
         };
@@ -344,6 +379,9 @@ impl<'ir> PlanAnalysis<'ir> {
     /// in `given` are: the plan cannot leave `state` (nor run any job
     /// there) while the `given` values hold. A proof: `false` when unknown.
     pub fn nothing_matches_given(&self, state: StateId, given: &[(LeafId, Value)]) -> bool {
+        if !self.analysed_over_cycles() {
+            return false;
+        }
         let Some(any) = self.conditions_covering(state) else {
             return false;
         };
@@ -468,7 +506,8 @@ impl<'ir> PlanAnalysis<'ir> {
             Outcome::Found(_) => {}
         }
         let candidates = self.candidates();
-        let search = Search::new(&self.terms, Mode::Witness, candidates, &[], fixed);
+        let search =
+            Search::new(&self.terms, Mode::Witness, candidates, &[], fixed).in_order(self.indexed);
         match search.run(f) {
             Outcome::Found(values) => Answer::Can(self.witness(f, state, values)),
             Outcome::None | Outcome::Unknown => Answer::Unknown,
@@ -572,6 +611,10 @@ impl<'ir> PlanAnalysis<'ir> {
             (_, Value::Float(f)) if f.is_nan() => "NaN".into(),
             (_, Value::Float(f)) if f.is_infinite() => if *f > 0.0 { "inf" } else { "-inf" }.into(),
             (_, Value::Float(f)) => crate::pretty::float(*f),
+            (Type::Array(e, _), Value::Array(xs)) => {
+                let xs: Vec<String> = xs.iter().map(|x| self.value_text(e, x)).collect();
+                format!("[{}]", xs.join(", "))
+            }
             (Type::Enum(e), Value::Enum(i)) => {
                 let def = &self.ir.enums[e.index()];
                 let variant = def

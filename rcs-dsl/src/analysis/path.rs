@@ -285,8 +285,17 @@ impl PlanAnalysis<'_> {
                 Leaf::Param(p, steps) if first => {
                     *at_path_mut(params.get_mut(p.index())?, steps)? = v.clone();
                 }
-                // Runs do not set subordinates' status fields yet: such a
-                // witness gets no run (and so no finding leans on one).
+                // A whole status field; a part of one (a field of a
+                // buffer it holds) a scenario sets only with the rest.
+                Leaf::SubField(x, f, steps) if steps.is_empty() => {
+                    let sub = ir.controller(*x);
+                    let var = sub.vars.get(f.index())?;
+                    let value = json_of(ir, &var.ty, v)?;
+                    step.status_fields
+                        .entry(sub.name.clone())
+                        .or_default()
+                        .insert(var.name.clone(), value);
+                }
                 Leaf::SubField(..) => return None,
                 _ => {}
             }
@@ -316,6 +325,13 @@ impl PlanAnalysis<'_> {
     pub fn pins_after(&self, prefix: &Run, wait: u32) -> Option<Vec<(LeafId, Value)>> {
         let scene = self.scene(prefix)?;
         Some(self.pins(&scene, prefix, wait))
+    }
+
+    /// The waits worth trying after `prefix` (see `waits`); `None` when
+    /// `prefix` does not replay.
+    pub(super) fn waits_after(&self, prefix: &Run) -> Option<Vec<u32>> {
+        let scene = self.scene(prefix)?;
+        Some(self.waits(&scene, prefix.steps.is_empty()))
     }
 
     /// What the interpreter holds after `run`: a fresh controller for the

@@ -11,9 +11,10 @@
 //! sequence of rows fires over and over ([`Expect::Repeats`]); a command
 //! storm is the same with one row ([`RunStep::fires_each_cycle`]).
 //!
-//! A run holds only what a scenario can set: `reads` buffers, hook results
-//! and subordinate statuses. Vars, counters and `new_command` follow from
-//! the steps; a run that needs other values of them is not built. Values
+//! A run holds only what a scenario can set: `reads` buffers, hook results,
+//! subordinate statuses and their status fields. Vars, counters and
+//! `new_command` follow from the steps; a run that needs other values of
+//! them is not built. Values
 //! are kept as a scenario writes them (JSON), so the diagnostic's JSON, the
 //! scenario file and the replay read the same thing.
 
@@ -49,6 +50,10 @@ pub struct RunStep {
     /// Subordinate statuses (echoing the last command sent), by name.
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub subordinates: BTreeMap<String, String>,
+    /// Subordinates' status fields, by subordinate then field name: each
+    /// published from this step on, until set again.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub status_fields: BTreeMap<String, BTreeMap<String, Json>>,
     pub cycles: u32,
     pub expect: Expect,
 }
@@ -68,6 +73,10 @@ pub enum Expect {
     /// the plan in its state: an oscillation, or with one row a command
     /// storm.
     Repeats { rows: Vec<Firing> },
+    /// No row fires until the last cycle, where an index by a value falls
+    /// outside its array and the plan ends with `INDEX_RANGE`: in `row`'s
+    /// jobs, or (`None`) in a condition, no row firing.
+    IndexRange { row: Option<String> },
 }
 
 impl Default for Expect {
@@ -89,15 +98,26 @@ impl Expect {
     fn fired_on(&self, i: u32, cycles: u32) -> Option<&str> {
         match self {
             Expect::Fires { row, .. } => (i + 1 == cycles).then_some(row.as_str()),
+            Expect::IndexRange { row } => row.as_deref().filter(|_| i + 1 == cycles),
             Expect::Stays { .. } => None,
             Expect::Repeats { rows } if rows.is_empty() => None,
             Expect::Repeats { rows } => Some(rows[i as usize % rows.len()].row.as_str()),
         }
     }
 
-    /// The row fired on the last cycle and the state after it.
-    fn last(&self, cycles: u32) -> (Option<&str>, &str) {
+    /// The row fired on the last cycle and the state after it (`None`:
+    /// the plan ended with `INDEX_RANGE`, in no state a scenario names).
+    fn last(&self, cycles: u32) -> (Option<&str>, Option<&str>) {
+        let (fired, state) = match self {
+            Expect::IndexRange { row } => return (row.as_deref(), None),
+            _ => self.last_in_state(cycles),
+        };
+        (fired, Some(state))
+    }
+
+    fn last_in_state(&self, cycles: u32) -> (Option<&str>, &str) {
         match self {
+            Expect::IndexRange { .. } => (None, "S0"),
             Expect::Fires { row, state } => (Some(row), state),
             Expect::Stays { state } => (None, state),
             Expect::Repeats { rows } => {
@@ -155,14 +175,19 @@ pub fn scenario_text(run: &Run, name: &str, about: &str) -> Result<String, Strin
         #[serde(skip_serializing_if = "BTreeMap::is_empty")]
         hooks: &'a BTreeMap<String, Json>,
         #[serde(skip_serializing_if = "BTreeMap::is_empty")]
-        subordinates: &'a BTreeMap<String, String>,
+        subordinates: BTreeMap<String, Json>,
         cycles: u32,
         expect: ExpectFile<'a>,
     }
     #[derive(Serialize)]
     struct ExpectFile<'a> {
         fired: &'a str,
-        state: &'a str,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        state: Option<&'a str>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        status: Option<&'a str>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        error: Option<&'a str>,
     }
     let command = if run.params.is_empty() {
         Json::String(run.command.clone())
@@ -191,6 +216,28 @@ pub fn scenario_text(run: &Run, name: &str, about: &str) -> Result<String, Strin
         .enumerate()
         .map(|(i, (s, subordinates))| {
             let (fired, state) = s.expect.last(s.cycles);
+            let ended = matches!(s.expect, Expect::IndexRange { .. });
+            let mut subordinates: BTreeMap<String, Json> = subordinates
+                .iter()
+                .map(|(x, status)| (x.clone(), Json::String(status.clone())))
+                .collect();
+            // A subordinate whose status fields the step sets: its status
+            // in force (or, never set, the scene's start: NOT_READY with
+            // echo 0) and the fields, in one setting.
+            for (x, fields) in &s.status_fields {
+                let mut m = serde_json::Map::new();
+                match subordinates.get(x) {
+                    Some(status) => {
+                        m.insert("status".into(), status.clone());
+                    }
+                    None => {
+                        m.insert("status".into(), Json::String("NOT_READY".into()));
+                        m.insert("echo".into(), Json::from(0));
+                    }
+                }
+                m.extend(fields.clone());
+                subordinates.insert(x.clone(), Json::Object(m));
+            }
             StepFile {
                 command: (i == 0).then(|| command.clone()),
                 reads: &s.reads,
@@ -200,6 +247,8 @@ pub fn scenario_text(run: &Run, name: &str, about: &str) -> Result<String, Strin
                 expect: ExpectFile {
                     fired: fired.unwrap_or("none"),
                     state,
+                    status: ended.then_some("ERROR"),
+                    error: ended.then_some("INDEX_RANGE"),
                 },
             }
         })

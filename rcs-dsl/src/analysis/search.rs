@@ -45,6 +45,10 @@ pub struct Search<'a> {
     buf: Buffers,
     nodes: u64,
     new_command: Option<LeafId>,
+    /// `Witness` only: `&&` and `||` decide left to right as the
+    /// interpreter does, so an operand with no value yet (or none at all:
+    /// an index out of range) leaves the rest undecided.
+    in_order: bool,
     state_cycles: Option<LeafId>,
     plan_cycles: Option<LeafId>,
 }
@@ -123,9 +127,19 @@ impl<'a> Search<'a> {
             buf,
             nodes: 0,
             new_command: find(Leaf::NewCommand),
+            in_order: false,
             state_cycles: find(Leaf::StateCycles),
             plan_cycles: find(Leaf::PlanCycles),
         }
+    }
+
+    /// This search, deciding `&&` and `||` strictly left to right when
+    /// `in_order` (a witness over conditions that index by a value: an
+    /// operand the interpreter reaches must have a value, the index in
+    /// range, for the witness to be what the interpreter computes).
+    pub fn in_order(mut self, in_order: bool) -> Search<'a> {
+        self.in_order = in_order && self.mode == Mode::Witness;
+        self
     }
 
     pub fn run(mut self, f: &Formula) -> Outcome {
@@ -229,6 +243,7 @@ impl<'a> Search<'a> {
                 for x in xs {
                     match self.value(x) {
                         Some(false) => return Some(false),
+                        None if self.in_order => return None,
                         None => all = None,
                         Some(true) => {}
                     }
@@ -240,6 +255,7 @@ impl<'a> Search<'a> {
                 for x in xs {
                     match self.value(x) {
                         Some(true) => return Some(true),
+                        None if self.in_order => return None,
                         None => any = None,
                         Some(false) => {}
                     }

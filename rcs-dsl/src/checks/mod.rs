@@ -7,6 +7,7 @@ mod graph;
 mod handshake;
 mod hang;
 mod hierarchy;
+mod index;
 mod limits;
 mod loops;
 pub(crate) mod names;
@@ -190,6 +191,7 @@ fn check_plan(
     hang::check_incomplete_states(c, p, conditions, analysis, sink);
     loops::check_livelocks(c, p, conditions, sink);
     loops::check_command_storms(ir, c, p, conditions, sink);
+    index::check_index_range(ir, c, p, conditions, sink);
 }
 
 /// [`analyse_controller`] for every controller, on as many threads as the

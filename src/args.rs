@@ -358,6 +358,14 @@ impl Common {
         }
     }
 
+    /// The cargo-style progress lines these options ask for.
+    pub(crate) fn status(&self) -> crate::output::Status {
+        crate::output::Status {
+            color: self.color(),
+            quiet: self.quiet,
+        }
+    }
+
     /// Whether to colour what goes to stderr.
     pub(crate) fn color(&self) -> bool {
         match self.color {

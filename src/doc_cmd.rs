@@ -92,10 +92,7 @@ pub(crate) struct DocArgs {
 
 pub(crate) fn doc(args: DocArgs) -> ExitCode {
     let start = Instant::now();
-    let status = Status {
-        color: args.common.color(),
-        quiet: args.common.quiet,
-    };
+    let status = args.common.status();
     let paths = default_paths(args.paths);
     let sets = match rcs_dsl::load_paths(&paths) {
         Ok(sets) => sets,

@@ -410,10 +410,7 @@ pub fn status_fn(status: &Status) -> impl Fn(&str) + '_ {
 
 pub(crate) fn test(args: TestArgs) -> ExitCode {
     let start = Instant::now();
-    let status = Status {
-        color: args.common.color(),
-        quiet: args.common.quiet,
-    };
+    let status = args.common.status();
     let targets = match targets(args.paths) {
         Ok(t) => t,
         Err(reason) => return fail(reason),

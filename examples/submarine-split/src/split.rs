@@ -218,30 +218,27 @@ pub(crate) fn main() -> ExitCode {
 fn statuses(system: &Sub) -> String {
     let mut parts = Vec::new();
     if let Some(c) = system.sm() {
-        parts.push(format!(
-            "SM={}/{}/{}",
-            c.verb_name().unwrap_or("-"),
-            c.state_name().unwrap_or("-"),
-            c.status().map_or("?", sm::Status::name)
-        ));
+        let status = c.status().map_or("?", sm::Status::name);
+        parts.push(part("SM", c.verb_name(), c.state_name(), status));
     }
     if let Some(c) = system.pr() {
-        parts.push(format!(
-            "PR={}/{}/{}",
-            c.verb_name().unwrap_or("-"),
-            c.state_name().unwrap_or("-"),
-            c.status().map_or("?", pr::Status::name)
-        ));
+        let status = c.status().map_or("?", pr::Status::name);
+        parts.push(part("PR", c.verb_name(), c.state_name(), status));
     }
     if let Some(c) = system.tb() {
-        parts.push(format!(
-            "TB={}/{}/{}",
-            c.verb_name().unwrap_or("-"),
-            c.state_name().unwrap_or("-"),
-            c.status().map_or("?", tb::Status::name)
-        ));
+        let status = c.status().map_or("?", tb::Status::name);
+        parts.push(part("TB", c.verb_name(), c.state_name(), status));
     }
     parts.join(" ")
+}
+
+/// `NAME=VERB/STATE/STATUS`, `-` for no verb or state yet.
+fn part(name: &str, verb: Option<&str>, state: Option<&str>, status: &str) -> String {
+    format!(
+        "{name}={}/{}/{status}",
+        verb.unwrap_or("-"),
+        state.unwrap_or("-")
+    )
 }
 
 /// Whether PR reports AT_GOAL.

@@ -306,54 +306,36 @@ impl Cx<'_, '_> {
             ast::ExprKind::Field(base, field) => self.field(base, field, span),
             ast::ExprKind::Index(base, idx) => {
                 let (b, bt) = self.infer(base, None);
-                let n = match self.index(idx) {
-                    Some(Subscript::Value(i)) => {
-                        return match bt {
-                            Ty::Known(Type::Array(elem, _)) => (
-                                mk(ExprKind::IndexBy(Box::new(b), Box::new(i)), (*elem).clone()),
-                                Ty::Known(*elem),
-                            ),
-                            Ty::Err => (err_expr(span), Ty::Err),
-                            t => {
-                                let t = self.ty_name(&t);
-                                self.mismatch(
-                                    base.span,
-                                    format!("cannot index into {t}"),
-                                    "not an array".to_string(),
-                                );
-                                (err_expr(span), Ty::Err)
-                            }
-                        };
-                    }
-                    Some(Subscript::Const(n)) => Some(n),
-                    None => None,
+                // A subscript that did not check is already reported.
+                let Some(sub) = self.index(idx) else {
+                    return (err_expr(span), Ty::Err);
                 };
-                match (bt, n) {
-                    (Ty::Err, _) | (_, None) => (err_expr(span), Ty::Err),
-                    (Ty::Known(Type::Array(elem, len)), Some(n)) => {
-                        if n >= len as u64 {
-                            self.mismatch(
-                                idx.span,
-                                format!("index {n} is out of bounds for an array of length {len}"),
-                                format!("valid indices are 0 to {}", len - 1),
-                            );
-                            return (err_expr(span), Ty::Err);
-                        }
-                        (
-                            mk(ExprKind::Index(Box::new(b), n as u32), (*elem).clone()),
-                            Ty::Known(*elem),
-                        )
-                    }
-                    (t, _) => {
+                let (elem, len) = match bt {
+                    Ty::Known(Type::Array(elem, len)) => (elem, len),
+                    Ty::Err => return (err_expr(span), Ty::Err),
+                    t => {
                         let t = self.ty_name(&t);
                         self.mismatch(
                             base.span,
                             format!("cannot index into {t}"),
                             "not an array".to_string(),
                         );
-                        (err_expr(span), Ty::Err)
+                        return (err_expr(span), Ty::Err);
                     }
-                }
+                };
+                let kind = match sub {
+                    Subscript::Value(i) => ExprKind::IndexBy(Box::new(b), Box::new(i)),
+                    Subscript::Const(n) if n >= len as u64 => {
+                        self.mismatch(
+                            idx.span,
+                            format!("index {n} is out of bounds for an array of length {len}"),
+                            format!("valid indices are 0 to {}", len - 1),
+                        );
+                        return (err_expr(span), Ty::Err);
+                    }
+                    Subscript::Const(n) => ExprKind::Index(Box::new(b), n as u32),
+                };
+                (mk(kind, (*elem).clone()), Ty::Known(*elem))
             }
             ast::ExprKind::Unary(op, inner) => self.unary(*op, inner, span),
             ast::ExprKind::Binary(op, l, r) => self.binary(*op, l, r, span),

@@ -314,6 +314,10 @@ pub enum UnOp {
     Neg,
 }
 
+/// An expression node. Plan sets hold hundreds of thousands of them, all
+/// alive between parsing and lowering, so the node is kept small: the rare
+/// parts (a `Type::` qualifier, a call's name) are boxed, and a test holds
+/// the size (`expr_nodes_stay_small`).
 #[derive(Clone, Debug)]
 pub struct Expr {
     pub kind: ExprKind,
@@ -322,7 +326,8 @@ pub struct Expr {
 
 #[derive(Clone, Debug)]
 pub enum ExprKind {
-    Int(u128),
+    /// An integer literal (the builder refuses one above `u64::MAX`).
+    Int(u64),
     Float(f64),
     Bool(bool),
     NewCommand,
@@ -330,13 +335,32 @@ pub enum ExprKind {
     PlanCycles,
     /// `cmd.P`
     CmdParam(Name),
-    /// A bare name or `Type::Variant`.
-    Path(Option<Name>, Name),
-    Call(Name, Vec<Expr>),
+    /// A bare name or `Type::Variant` (the qualifier boxed: it is rare).
+    Path(Option<Box<Name>>, Name),
+    /// A hook or builtin call (the name boxed: calls are few).
+    Call(Box<Name>, Vec<Expr>),
     Field(Box<Expr>, Name),
     Index(Box<Expr>, Box<Expr>),
     Unary(UnOp, Box<Expr>),
     Binary(BinOp, Box<Expr>, Box<Expr>),
     Cast(Box<Expr>, Name),
     Paren(Box<Expr>),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The AST of a plan set is the peak of `check`'s memory (every file
+    /// is parsed before lowering starts), and every byte of a node is paid
+    /// for in page faults: keep the common nodes at their present size.
+    #[test]
+    fn expr_nodes_stay_small() {
+        assert!(
+            std::mem::size_of::<Expr>() <= 72,
+            "ast::Expr grew to {} bytes",
+            std::mem::size_of::<Expr>()
+        );
+        assert!(std::mem::size_of::<Name>() <= 40);
+    }
 }

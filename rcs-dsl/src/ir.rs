@@ -659,7 +659,7 @@ impl Controller {
 
 impl Expr {
     /// Call `f` on this expression and every sub-expression, parents first.
-    pub fn visit(&self, f: &mut dyn FnMut(&Expr)) {
+    pub fn visit<'a>(&'a self, f: &mut dyn FnMut(&'a Expr)) {
         f(self);
         match &self.kind {
             ExprKind::Field(e, _)
@@ -701,7 +701,7 @@ impl Job {
 
 impl Row {
     /// Every expression of the row: its condition, then its jobs' in order.
-    pub fn visit_exprs(&self, f: &mut dyn FnMut(&Expr)) {
+    pub fn visit_exprs<'a>(&'a self, f: &mut dyn FnMut(&'a Expr)) {
         if let Condition::When(c) = &self.cond {
             c.visit(f);
         }
@@ -711,14 +711,14 @@ impl Row {
 
 impl EveryCycle {
     /// Every expression of the block's jobs, in order.
-    pub fn visit_exprs(&self, f: &mut dyn FnMut(&Expr)) {
+    pub fn visit_exprs<'a>(&'a self, f: &mut dyn FnMut(&'a Expr)) {
         visit_job_exprs(&self.jobs, f);
     }
 }
 
 /// Every expression of `jobs`, in order (assignment targets are places,
 /// not expressions: only their run-time indices are visited, after the value).
-pub fn visit_job_exprs(jobs: &[Job], f: &mut dyn FnMut(&Expr)) {
+pub fn visit_job_exprs<'a>(jobs: &'a [Job], f: &mut dyn FnMut(&'a Expr)) {
     for j in jobs {
         match j {
             Job::Assign { value, place, .. } => {

@@ -75,24 +75,43 @@ struct Met {
 
 /// The sites of `plan`, their formulas interned in `terms` (before the
 /// cells are made, so that 0 and each length cut the index's cells).
-pub(super) fn sites(ir: &Ir, ctrl: &Controller, plan: &Plan, terms: &mut Terms) -> Vec<Site> {
-    let assigned = super::assigned_vars(ctrl);
+pub(super) fn sites<'ir>(
+    ir: &Ir,
+    ctrl: &Controller,
+    plan: &'ir Plan,
+    terms: &mut Terms<'ir>,
+) -> Vec<Site> {
+    // Made on first use: most plans have no index by a value.
+    let assigned = std::cell::OnceCell::new();
+    let assigned = || {
+        assigned
+            .get_or_init(|| super::assigned_vars(ctrl))
+            .as_slice()
+    };
     let printer = crate::pretty::Printer::new(ir, ctrl, Some(plan));
     let mut out = Vec::new();
     for (r, row) in plan.rows.iter().enumerate() {
         // Indices met in order: the condition's, then each job's.
+        // A unit that meets no index adds nothing (no site, no guard for
+        // later units): most rows have none, and skip all the work.
         let mut units: Vec<(Option<usize>, Vec<Met>)> = Vec::new();
         if let Condition::When(c) = &row.cond {
-            let mut met = Vec::new();
-            in_condition(terms, &printer, c, Vec::new(), &mut met);
-            units.push((None, met));
+            if c.indexes_by_value() {
+                let mut met = Vec::new();
+                in_condition(terms, &printer, c, Vec::new(), &mut met);
+                units.push((None, met));
+            }
         }
         for (k, job) in row.jobs.iter().enumerate() {
-            let mut met = Vec::new();
-            in_job(ir, ctrl, &printer, job, &mut met);
-            units.push((Some(k), met));
+            if job.indexes_by_value() {
+                let mut met = Vec::new();
+                in_job(ir, ctrl, &printer, job, &mut met);
+                units.push((Some(k), met));
+            }
         }
-        add_sites(terms, ctrl, &assigned, r, false, units, &mut out);
+        if !units.is_empty() {
+            add_sites(terms, ctrl, assigned(), r, false, units, &mut out);
+        }
     }
     // `pre` runs on every cycle of every plan: its indices go with the
     // controller's first plan only, so that each is reported once.
@@ -108,7 +127,7 @@ pub(super) fn sites(ir: &Ir, ctrl: &Controller, plan: &Plan, terms: &mut Terms) 
                 (Some(k), met)
             })
             .collect();
-        add_sites(terms, ctrl, &assigned, 0, true, units, &mut out);
+        add_sites(terms, ctrl, assigned(), 0, true, units, &mut out);
     }
     out
 }
@@ -208,10 +227,10 @@ fn out_formula(
     };
     let mut parts = Vec::new();
     if lo < 0 {
-        parts.push(terms.formula(&cmp(BinOp::Lt, 0)));
+        parts.push(terms.made_atom(cmp(BinOp::Lt, 0)));
     }
     if hi >= i128::from(len) {
-        parts.push(terms.formula(&cmp(BinOp::Ge, i128::from(len))));
+        parts.push(terms.made_atom(cmp(BinOp::Ge, i128::from(len))));
     }
     Some(Formula::Or(parts))
 }
@@ -219,10 +238,10 @@ fn out_formula(
 /// The indices of condition `e`, each with the operands of `&&` and `||`
 /// that must hold for the interpreter to get to it (as the formula of the
 /// condition splits them: [`Terms::formula`]).
-fn in_condition(
-    terms: &mut Terms,
+fn in_condition<'ir>(
+    terms: &mut Terms<'ir>,
     printer: &crate::pretty::Printer,
-    e: &Expr,
+    e: &'ir Expr,
     guard: Vec<Formula>,
     out: &mut Vec<Met>,
 ) {

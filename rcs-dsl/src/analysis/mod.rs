@@ -111,7 +111,7 @@ pub struct PlanAnalysis<'ir> {
     ir: &'ir Ir,
     ctrl: &'ir Controller,
     plan: &'ir Plan,
-    terms: Terms,
+    terms: Terms<'ir>,
     /// Per row: its condition (`None` for `otherwise`).
     conds: Vec<Option<Arc<Formula>>>,
     /// Per leaf: a representative value of each of its cells.
@@ -277,7 +277,7 @@ impl<'ir> PlanAnalysis<'ir> {
 
     /// The leaves, by id: what a [`Witness`] and the `given` values of the
     /// `*_given` questions are made of.
-    pub fn terms(&self) -> &Terms {
+    pub fn terms(&self) -> &Terms<'ir> {
         &self.terms
     }
 

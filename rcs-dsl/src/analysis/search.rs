@@ -34,7 +34,7 @@ pub enum Outcome {
 }
 
 pub struct Search<'a> {
-    terms: &'a Terms,
+    terms: &'a Terms<'a>,
     mode: Mode,
     /// `Prove` only: per exact atom, its truth value on each cell of its
     /// leaf (one leaf; constant atoms have one entry).
@@ -95,7 +95,7 @@ impl<'a> Search<'a> {
     /// A search over `domains` (cells or candidates, per leaf) with the
     /// leaves in `fixed` already set.
     pub fn new(
-        terms: &'a Terms,
+        terms: &'a Terms<'a>,
         mode: Mode,
         domains: &'a [Vec<Value>],
         tables: &'a [Option<Vec<bool>>],

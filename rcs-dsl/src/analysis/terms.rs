@@ -72,25 +72,47 @@ impl Formula {
 
 /// One atom: its expression, the leaves it reads and whether it is exact.
 #[derive(Clone, Debug)]
-pub struct Atom {
-    pub expr: Expr,
+pub struct Atom<'ir> {
+    /// The atom's expression: the IR's own (borrowed), or one the analysis
+    /// made (`i < 0` for an index it checks).
+    pub expr: AtomExpr<'ir>,
     pub leaves: Vec<LeafId>,
     pub exact: bool,
 }
 
 /// Leaves and atoms of one plan's conditions, each interned once.
 #[derive(Clone, Debug, Default)]
-pub struct Terms {
+pub struct Terms<'ir> {
     pub leaves: Vec<(Leaf, Type)>,
-    pub atoms: Vec<Atom>,
+    pub atoms: Vec<Atom<'ir>>,
     /// Per exact leaf: the constants its exact atoms compare it with
     /// (evaluated in the leaf's type).
-    pub splits: Vec<Vec<Expr>>,
+    pub splits: Vec<Vec<AtomExpr<'ir>>>,
 }
 
-impl Terms {
+/// An expression of the analysis: the IR's own (most), or one it made
+/// (`i < 0` for an index it checks), boxed so that the common case is a
+/// pointer and an atom stays small.
+#[derive(Clone, Debug)]
+pub enum AtomExpr<'ir> {
+    Ir(&'ir Expr),
+    Made(Box<Expr>),
+}
+
+impl std::ops::Deref for AtomExpr<'_> {
+    type Target = Expr;
+
+    fn deref(&self) -> &Expr {
+        match self {
+            AtomExpr::Ir(e) => e,
+            AtomExpr::Made(e) => e,
+        }
+    }
+}
+
+impl<'ir> Terms<'ir> {
     /// The formula of a condition, interning its atoms and leaves.
-    pub fn formula(&mut self, e: &Expr) -> Formula {
+    pub fn formula(&mut self, e: &'ir Expr) -> Formula {
         match &e.kind {
             ExprKind::Bool(b) => Formula::Const(*b),
             ExprKind::Unary(UnOp::Not, x) => Formula::Not(Box::new(self.formula(x))),
@@ -107,12 +129,17 @@ impl Terms {
                 self.chain(e, BinOp::Or, &mut xs);
                 Formula::Or(xs)
             }
-            _ => Formula::Atom(self.atom(e)),
+            _ => Formula::Atom(self.atom(AtomExpr::Ir(e))),
         }
     }
 
+    /// The formula of one atom the analysis made itself.
+    pub fn made_atom(&mut self, e: Expr) -> Formula {
+        Formula::Atom(self.atom(AtomExpr::Made(Box::new(e))))
+    }
+
     /// The operands of a chain of `op` (left to right), as formulas.
-    fn chain(&mut self, e: &Expr, op: BinOp, out: &mut Vec<Formula>) {
+    fn chain(&mut self, e: &'ir Expr, op: BinOp, out: &mut Vec<Formula>) {
         match &e.kind {
             ExprKind::Binary(o, l, r) if *o == op => {
                 self.chain(l, op, out);
@@ -122,75 +149,98 @@ impl Terms {
         }
     }
 
-    fn atom(&mut self, e: &Expr) -> AtomId {
-        if let Some(i) = self.atoms.iter().position(|a| same_expr(&a.expr, e)) {
+    fn atom(&mut self, e: AtomExpr<'ir>) -> AtomId {
+        if let Some(i) = self.atoms.iter().position(|a| same_expr(&a.expr, &e)) {
             return i;
         }
         let mut leaves = Vec::new();
         let mut scalar = true;
-        self.collect_leaves(e, &mut leaves, &mut scalar);
+        self.collect_leaves(&e, &mut leaves, &mut scalar);
         leaves.dedup();
-        let exact = scalar && self.exact(e, &leaves);
+        // The split constant is borrowed from the IR with the atom, or
+        // copied out of an atom the analysis made.
+        let split = match &e {
+            AtomExpr::Ir(b) => self.exact(b, &leaves).map(|c| c.map(AtomExpr::Ir)),
+            AtomExpr::Made(o) => self
+                .exact(o, &leaves)
+                .map(|c| c.map(|c| AtomExpr::Made(Box::new(c.clone())))),
+        };
+        let exact = scalar && split.is_some();
+        if let (true, Some(Some(c)), [leaf]) = (exact, split, leaves.as_slice()) {
+            self.splits[*leaf].push(c);
+        }
         self.atoms.push(Atom {
-            expr: e.clone(),
+            expr: e,
             leaves,
             exact,
         });
         self.atoms.len() - 1
     }
 
-    /// Whether atom `e` over `leaves` is exact, registering its split
-    /// constant with its leaf if it is.
-    fn exact(&mut self, e: &Expr, leaves: &[LeafId]) -> bool {
+    /// Whether atom `e` over `leaves` is exact (`Some`), and then the
+    /// constant it compares its leaf with, if any: where its leaf's cells
+    /// are split.
+    fn exact<'e>(&self, e: &'e Expr, leaves: &[LeafId]) -> Option<Option<&'e Expr>> {
         match leaves {
-            [] => true,
+            [] => Some(None),
             [leaf] => {
-                if as_leaf(e).is_some() {
+                if is_leaf(e) {
                     // A bool leaf, or `X.done`-style view of a status leaf.
-                    return true;
+                    return Some(None);
                 }
                 let ExprKind::Binary(op, l, r) = &e.kind else {
-                    return false;
+                    return None;
                 };
                 if !matches!(
                     op,
                     BinOp::Eq | BinOp::Ne | BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge
                 ) {
-                    return false;
+                    return None;
                 }
-                let constant = match (as_leaf(l).is_some(), as_leaf(r).is_some()) {
+                let constant = match (is_leaf(l), is_leaf(r)) {
                     (true, false) if leaf_free(r) => r,
                     (false, true) if leaf_free(l) => l,
-                    _ => return false,
+                    _ => return None,
                 };
                 let t = &self.leaves[*leaf].1;
                 if !matches!(
                     t,
                     Type::Int(_) | Type::Float(_) | Type::Enum(_) | Type::Status(_) | Type::Bool
                 ) {
-                    return false;
+                    return None;
                 }
-                let c = (**constant).clone();
-                self.splits[*leaf].push(c);
-                true
+                Some(Some(&**constant))
             }
-            _ => false,
+            _ => None,
         }
     }
 
     fn collect_leaves(&mut self, e: &Expr, out: &mut Vec<LeafId>, scalar: &mut bool) {
-        if let Some(leaf) = as_leaf(e) {
-            let ty = match leaf {
-                Leaf::SubStatus(c) => Type::Status(c),
-                _ => e.ty.clone(),
+        if is_leaf(e) {
+            // A subordinate's status, seen through `X.done` and the like.
+            let status = match &e.kind {
+                ExprKind::Sub(c, p) if *p != SubProp::StaleCycles => Some(*c),
+                _ => None,
             };
+            let ty = status.map_or(&e.ty, |_| &Type::Bool);
             if !matches!(
                 ty,
                 Type::Bool | Type::Int(_) | Type::Float(_) | Type::Enum(_) | Type::Status(_)
             ) {
                 *scalar = false;
             }
-            let id = self.intern(leaf, ty);
+            // Found without building the leaf (a path of fields is a
+            // vector): most leaves are read by several atoms.
+            let id = match self.leaves.iter().position(|(l, _)| same_leaf_as(e, l)) {
+                Some(id) => id,
+                None => {
+                    let leaf = as_leaf(e).expect("is_leaf said so");
+                    let ty = status.map_or_else(|| e.ty.clone(), Type::Status);
+                    self.leaves.push((leaf, ty));
+                    self.splits.push(Vec::new());
+                    self.leaves.len() - 1
+                }
+            };
             if !out.contains(&id) {
                 out.push(id);
             }
@@ -236,6 +286,31 @@ impl Terms {
         self.leaves.push((leaf, ty));
         self.splits.push(Vec::new());
         self.leaves.len() - 1
+    }
+}
+
+/// Whether [`as_leaf`] finds a leaf in `e` (without building it).
+pub fn is_leaf(e: &Expr) -> bool {
+    match &e.kind {
+        ExprKind::NewCommand
+        | ExprKind::StateCycles
+        | ExprKind::PlanCycles
+        | ExprKind::Call(..)
+        | ExprKind::Sub(..) => true,
+        _ => is_place_leaf(e),
+    }
+}
+
+/// A place leaf: a parameter, var, buffer or status field, then constant
+/// projections (the leaves [`with_step`] extends).
+fn is_place_leaf(e: &Expr) -> bool {
+    match &e.kind {
+        ExprKind::CmdParam(..)
+        | ExprKind::Var(_)
+        | ExprKind::Buffer(_)
+        | ExprKind::SubField(..) => true,
+        ExprKind::Field(x, _) | ExprKind::Index(x, _) => is_place_leaf(x),
+        _ => false,
     }
 }
 
@@ -286,11 +361,54 @@ fn with_step(leaf: Leaf, step: Step) -> Option<Leaf> {
 fn leaf_free(e: &Expr) -> bool {
     let mut free = true;
     e.visit(&mut |x| {
-        if as_leaf(x).is_some() || matches!(x.kind, ExprKind::IndexBy(..)) {
+        if is_leaf(x) || matches!(x.kind, ExprKind::IndexBy(..)) {
             free = false;
         }
     });
     free
+}
+
+/// Whether `e` reads leaf `leaf` as a whole: `same_leaf(&as_leaf(e)?, leaf)`
+/// without building the leaf.
+fn same_leaf_as(e: &Expr, leaf: &Leaf) -> bool {
+    match (&e.kind, leaf) {
+        (ExprKind::NewCommand, Leaf::NewCommand)
+        | (ExprKind::StateCycles, Leaf::StateCycles)
+        | (ExprKind::PlanCycles, Leaf::PlanCycles) => true,
+        (ExprKind::Call(h, xs), Leaf::Call(k, ys)) => {
+            h == k && xs.len() == ys.len() && xs.iter().zip(ys).all(|(x, y)| same_expr(x, y))
+        }
+        (ExprKind::Sub(c, SubProp::StaleCycles), Leaf::SubStale(d)) => c == d,
+        (ExprKind::Sub(c, p), Leaf::SubStatus(d)) => *p != SubProp::StaleCycles && c == d,
+        (
+            _,
+            Leaf::Param(_, steps)
+            | Leaf::Var(_, steps)
+            | Leaf::Buffer(_, steps)
+            | Leaf::SubField(_, _, steps),
+        ) => same_place_as(e, leaf, steps),
+        _ => false,
+    }
+}
+
+/// Whether `e` is the place leaf `leaf` followed by `steps` (the last step
+/// outermost).
+fn same_place_as(e: &Expr, leaf: &Leaf, steps: &[Step]) -> bool {
+    match (&e.kind, steps.split_last()) {
+        (ExprKind::Field(x, f), Some((Step::Field(g), rest))) => {
+            f == g && same_place_as(x, leaf, rest)
+        }
+        (ExprKind::Index(x, i), Some((Step::Index(j), rest))) => {
+            i == j && same_place_as(x, leaf, rest)
+        }
+        (ExprKind::CmdParam(_, p), None) => matches!(leaf, Leaf::Param(q, _) if q == p),
+        (ExprKind::Var(v), None) => matches!(leaf, Leaf::Var(w, _) if w == v),
+        (ExprKind::Buffer(b), None) => matches!(leaf, Leaf::Buffer(c, _) if c == b),
+        (ExprKind::SubField(c, v), None) => {
+            matches!(leaf, Leaf::SubField(d, w, _) if d == c && w == v)
+        }
+        _ => false,
+    }
 }
 
 /// Whether two leaves are the same input (hook calls: the same hook with
@@ -316,4 +434,75 @@ pub fn same_leaf(a: &Leaf, b: &Leaf) -> bool {
 /// backends use to evaluate a condition's hook call once per cycle.
 pub fn same_expr(a: &Expr, b: &Expr) -> bool {
     a == b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// The expressions of every condition and job of every plan set the
+    /// repository has (golden ok cases and `plans/`), per plan.
+    fn plan_exprs(visit: &mut dyn FnMut(&[&Expr])) {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let mut paths = Vec::new();
+        for folder in ["tests/data/ok", "plans"] {
+            for entry in std::fs::read_dir(root.join(folder)).expect("folder") {
+                let path = entry.expect("entry").path();
+                let is_set = path.is_dir() && !path.ends_with("snapshots")
+                    || path.extension().is_some_and(|e| e == "rcs");
+                if is_set {
+                    paths.push(path);
+                }
+            }
+        }
+        paths.sort();
+        assert!(paths.len() > 100, "the plan sets were found");
+        for sets in paths
+            .iter()
+            .filter_map(|p| crate::load::load_paths(std::slice::from_ref(p)).ok())
+        {
+            for set in &sets {
+                let Some(ir) = crate::lower_unchecked(set) else {
+                    continue;
+                };
+                for p in ir.controllers.iter().flat_map(|c| &c.plans) {
+                    let mut all = Vec::new();
+                    for r in &p.rows {
+                        r.visit_exprs(&mut |e| all.push(e));
+                    }
+                    visit(&all);
+                }
+            }
+        }
+    }
+
+    /// `is_leaf` and `same_leaf_as` decide without building a leaf what
+    /// `as_leaf` and `same_leaf` decide by building it: the same answers
+    /// on every expression of every plan set of the repository.
+    #[test]
+    fn leaves_are_found_without_building_them_as_when_built() {
+        let (mut leaves, mut pairs) = (0, 0);
+        plan_exprs(&mut |exprs| {
+            for e in exprs {
+                assert_eq!(is_leaf(e), as_leaf(e).is_some(), "{e:?}");
+            }
+            let leafy: Vec<(&Expr, Leaf)> = exprs
+                .iter()
+                .filter_map(|e| Some((*e, as_leaf(e)?)))
+                .collect();
+            leaves += leafy.len();
+            for (e, _) in &leafy {
+                for (f, leaf) in &leafy {
+                    let built = same_leaf(&as_leaf(e).expect("a leaf"), leaf);
+                    assert_eq!(same_leaf_as(e, leaf), built, "{e:?}\n{f:?}");
+                    pairs += usize::from(built);
+                }
+            }
+        });
+        assert!(
+            leaves > 1000 && pairs > leaves,
+            "{leaves} leaves, {pairs} equal pairs"
+        );
+    }
 }

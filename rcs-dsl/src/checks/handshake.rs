@@ -12,7 +12,8 @@ use crate::analysis::{covers, PlanAnalysis};
 use crate::ast::BinOp;
 use crate::diagnostic::Diagnostic;
 use crate::ir::{
-    CommandId, CtrlId, Expr, ExprKind, From, Ir, Job, Row, StateId, StatusId, SubProp, Target,
+    CommandId, Controller, CtrlId, Expr, ExprKind, From, Ir, Job, Plan, Row, StateId, StatusId,
+    SubProp, Target,
 };
 use crate::lint::Lint;
 
@@ -20,17 +21,61 @@ use crate::lint::Lint;
 /// to pass any timeout a reader would expect to have fired.
 const STALL_CYCLES: u32 = 30;
 
-/// Per controller, per plan: the analysis of its conditions and its graph.
-pub(crate) struct Plans<'a> {
-    pub conditions: Vec<Vec<PlanAnalysis<'a>>>,
-    pub graphs: Vec<Vec<Analysis>>,
+/// What a supervisor's handshake checks need of a subordinate's plans,
+/// taken from the subordinate's analyses as soon as they are made: the
+/// checks of each controller then run on the worker threads with its own
+/// analyses and its subordinates' summaries, and no controller's analyses
+/// have to outlive its own checks.
+pub(crate) struct Summary {
+    /// Per plan: the first row that ends in `Error` and that the analysis
+    /// cannot rule out.
+    error_rows: Vec<Option<usize>>,
+    /// Per plan: the statuses its rows that can fire report (`DONE` and
+    /// `ERROR` for rows ending there), in row order.
+    reported: Vec<Vec<StatusId>>,
 }
 
-pub(crate) fn check_unhandled_error(ir: &Ir, plans: &Plans, sink: &mut Sink) {
-    for (ci, c) in ir.controllers.iter().enumerate() {
+impl Summary {
+    pub(crate) fn of(c: &Controller, conditions: &[PlanAnalysis], graphs: &[Analysis]) -> Summary {
+        let plans = c.plans.iter().zip(conditions).zip(graphs);
+        let error_rows = plans
+            .clone()
+            .map(|((plan, _), graph)| {
+                plan.rows.iter().position(|r| {
+                    matches!(r.to, Target::Error(_))
+                        && !graph.never_matches[r.position as usize]
+                        && match r.from {
+                            From::State(s) => graph.reachable[s.index()],
+                            From::DontCare(_) => true,
+                        }
+                })
+            })
+            .collect();
+        let reported = plans
+            .map(|((plan, conditions), graph)| reported_by(plan, conditions, graph))
+            .collect();
+        Summary {
+            error_rows,
+            reported,
+        }
+    }
+}
+
+/// `unhandled_error` in the plans of controller `ci`, over their analyses
+/// and the summaries of every controller.
+pub(crate) fn check_unhandled_error(
+    ir: &Ir,
+    ci: CtrlId,
+    conditions: &[PlanAnalysis],
+    graphs: &[Analysis],
+    summaries: &[Summary],
+    sink: &mut Sink,
+) {
+    let c = ir.controller(ci);
+    {
         for (pi, p) in c.plans.iter().enumerate() {
-            let conditions = &plans.conditions[ci][pi];
-            let graph = &plans.graphs[ci][pi];
+            let conditions = &conditions[pi];
+            let graph = &graphs[pi];
             // A plan too large to analyse: nothing can be proved of it.
             if !conditions.analysed() {
                 continue;
@@ -41,7 +86,7 @@ pub(crate) fn check_unhandled_error(ir: &Ir, plans: &Plans, sink: &mut Sink) {
                 // The verbs this plan sends X, and a row of X's plans for
                 // them that can end in Error.
                 let sent = verbs_sent(&p.rows, x);
-                let Some(fails) = sent.iter().find_map(|v| error_row(ir, plans, x, *v)) else {
+                let Some(fails) = sent.iter().find_map(|v| error_row(ir, summaries, x, *v)) else {
                     continue;
                 };
                 for s in (0..p.states.len()).filter(|s| graph.reachable[*s]) {
@@ -117,21 +162,9 @@ fn verbs_sent(rows: &[Row], x: CtrlId) -> Vec<CommandId> {
 
 /// A row of `x`'s plan for `verb` that ends in `Error` and that the
 /// analysis cannot rule out: (plan index, row index).
-fn error_row(ir: &Ir, plans: &Plans, x: CtrlId, verb: CommandId) -> Option<(usize, usize)> {
+fn error_row(ir: &Ir, summaries: &[Summary], x: CtrlId, verb: CommandId) -> Option<(usize, usize)> {
     let pid = ir.controller(x).commands[verb.index()].plan?.index();
-    let plan = &ir.controller(x).plans[pid];
-    let graph = &plans.graphs[x.index()][pid];
-    plan.rows
-        .iter()
-        .position(|r| {
-            matches!(r.to, Target::Error(_))
-                && !graph.never_matches[r.position as usize]
-                && match r.from {
-                    From::State(s) => graph.reachable[s.index()],
-                    From::DontCare(_) => true,
-                }
-        })
-        .map(|r| (pid, r))
+    summaries[x.index()].error_rows[pid].map(|r| (pid, r))
 }
 
 /// Whether a row's condition tests `x.done` (or `x.status == DONE`).
@@ -160,11 +193,17 @@ fn is_done_test(e: &Expr, x: CtrlId) -> bool {
 /// the verbs the supervisor sends it, reports `S`. `EXECUTING` and
 /// `NOT_READY` come from the handshake, never from a row, and a test of
 /// `ERROR` is defensive handling: those three are not judged.
-pub(crate) fn check_status_never_reported(ir: &Ir, plans: &Plans, sink: &mut Sink) {
-    for (ci, c) in ir.controllers.iter().enumerate() {
+pub(crate) fn check_status_never_reported(
+    ir: &Ir,
+    ci: CtrlId,
+    summaries: &[Summary],
+    sink: &mut Sink,
+) {
+    let c = ir.controller(ci);
+    {
         for &x in &c.subordinates {
             // One supervisor only commands X (two is an error of its own).
-            if ir.controller(x).supervisor != Some(CtrlId(ci as u32)) {
+            if ir.controller(x).supervisor != Some(ci) {
                 continue;
             }
             let sent: Vec<CommandId> = c.plans.iter().flat_map(|p| verbs_sent(&p.rows, x)).fold(
@@ -176,7 +215,7 @@ pub(crate) fn check_status_never_reported(ir: &Ir, plans: &Plans, sink: &mut Sin
                     vs
                 },
             );
-            let Some(reported) = statuses_reported(ir, plans, x, &sent) else {
+            let Some(reported) = statuses_reported(ir, summaries, x, &sent) else {
                 continue;
             };
             for p in &c.plans {
@@ -255,21 +294,32 @@ fn never_reported(
 /// runs for `verbs`; `None` when a verb has no plan (nothing to judge).
 fn statuses_reported(
     ir: &Ir,
-    plans: &Plans,
+    summaries: &[Summary],
     x: CtrlId,
     verbs: &[CommandId],
 ) -> Option<Vec<StatusId>> {
+    let mut reported = Vec::new();
+    for v in verbs {
+        let pid = ir.controller(x).commands[v.index()].plan?.index();
+        for s in &summaries[x.index()].reported[pid] {
+            if !reported.contains(s) {
+                reported.push(*s);
+            }
+        }
+    }
+    Some(reported)
+}
+
+/// The statuses the rows of `plan` that can fire report, in row order,
+/// without repeats.
+fn reported_by(plan: &Plan, conditions: &PlanAnalysis, graph: &Analysis) -> Vec<StatusId> {
     let mut reported = Vec::new();
     let mut add = |s: StatusId| {
         if !reported.contains(&s) {
             reported.push(s);
         }
     };
-    for v in verbs {
-        let pid = ir.controller(x).commands[v.index()].plan?.index();
-        let plan = &ir.controller(x).plans[pid];
-        let graph = &plans.graphs[x.index()][pid];
-        let conditions = &plans.conditions[x.index()][pid];
+    {
         for (i, r) in plan.rows.iter().enumerate() {
             let can_fire = !graph.never_matches[i]
                 && (0..plan.states.len()).any(|s| {
@@ -290,7 +340,7 @@ fn statuses_reported(
             }
         }
     }
-    Some(reported)
+    reported
 }
 
 /// The statuses of `x` a row's condition waits for, with the test's span:

@@ -17,7 +17,7 @@ mod usage;
 
 use crate::analysis::PlanAnalysis;
 use crate::diagnostic::{Diagnostic, Diagnostics};
-use crate::ir::{Controller, Ir, Plan};
+use crate::ir::{Controller, CtrlId, Ir, Plan};
 use crate::lint::{Lint, LintLevels};
 use crate::source::SourceMap;
 
@@ -98,49 +98,71 @@ pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagno
     plan::check_missing_plans(ir, &mut sink);
     names::check_case_collisions(ir, &mut sink);
     // The analysis of every plan's conditions and its graph, and the
-    // checks of each plan, controller by controller on worker threads; the
-    // handshake checks then ask the subordinates' analyses.
-    let (conditions, graphs, found) = analyse_plans(ir, levels);
+    // checks of each plan, controller by controller on worker threads.
+    let plans: usize = ir.controllers.iter().map(|c| c.plans.len()).sum();
+    let many = plans >= PARALLEL_PLANS;
+    let ids: Vec<CtrlId> = (0..ir.controllers.len() as u32).map(CtrlId).collect();
+    let analysed =
+        crate::parallel::map_ordered(&ids, many, |ci| analyse_controller(ir, *ci, levels));
+    let mut summaries = Vec::with_capacity(analysed.len());
+    let mut uses = Vec::with_capacity(analysed.len());
+    let mut kept = Vec::with_capacity(analysed.len());
+    for a in analysed {
+        sink.diags.extend(a.diags);
+        summaries.push(a.summary);
+        uses.push(a.uses);
+        kept.push(std::sync::Mutex::new(Some((a.conditions, a.graphs))));
+    }
+    usage::check_unused_declarations(ir, &uses, &mut sink);
+    // Then, again on the worker threads, the handshake checks of each
+    // controller, over its own analyses and its subordinates' summaries;
+    // each controller's analyses are freed where they were last used.
+    let found = crate::parallel::map_ordered(&ids, many, |ci| {
+        let taken = kept[ci.index()]
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .take();
+        let Some((conditions, graphs)) = taken else {
+            return Diagnostics::new();
+        };
+        let mut diags = Diagnostics::new();
+        let mut sink = Sink {
+            levels,
+            diags: &mut diags,
+        };
+        handshake::check_unhandled_error(ir, *ci, &conditions, &graphs, &summaries, &mut sink);
+        handshake::check_status_never_reported(ir, *ci, &summaries, &mut sink);
+        drop((conditions, graphs));
+        diags
+    });
     for d in found {
         sink.diags.extend(d);
     }
-    let plans = handshake::Plans { conditions, graphs };
-    handshake::check_unhandled_error(ir, &plans, &mut sink);
-    handshake::check_status_never_reported(ir, &plans, &mut sink);
-    let many = plans.conditions.iter().map(Vec::len).sum::<usize>() >= PARALLEL_PLANS;
-    std::thread::scope(|scope| {
-        // Freeing the analyses of many plans takes about as long as the
-        // checks below: it happens beside them.
-        if many {
-            scope.spawn(move || drop(plans));
-        } else {
-            drop(plans);
-        }
-        hierarchy::check_span_of_control(ir, &mut sink);
-        hierarchy::check_level_order(ir, &mut sink);
-        usage::check_float_equality(ir, &mut sink);
-        usage::check_unused(ir, &mut sink);
-    });
+    hierarchy::check_span_of_control(ir, &mut sink);
+    hierarchy::check_level_order(ir, &mut sink);
     diags.sort_from(start, sources);
 }
 
 /// Below a few dozen plans a thread costs more than it saves.
 const PARALLEL_PLANS: usize = 64;
 
-/// Per controller: the analysis of each plan's conditions, each plan's
-/// graph, and the findings of the checks of its plans.
-type Analysed<'ir> = (
-    Vec<Vec<PlanAnalysis<'ir>>>,
-    Vec<Vec<graph::Analysis>>,
-    Vec<Diagnostics>,
-);
+/// One controller's analyses and what its checks found.
+struct Analysed<'ir> {
+    /// Per plan: the analysis of its conditions and its graph.
+    conditions: Vec<PlanAnalysis<'ir>>,
+    graphs: Vec<graph::Analysis>,
+    /// What its supervisor's handshake checks need of its plans.
+    summary: handshake::Summary,
+    /// What its rows use of declarations outside it.
+    uses: usage::Uses,
+    diags: Diagnostics,
+}
 
-/// One controller's plans: analysed, then checked one by one.
-fn analyse_controller<'ir>(
-    ir: &'ir Ir,
-    c: &'ir Controller,
-    levels: &LintLevels,
-) -> (Vec<PlanAnalysis<'ir>>, Vec<graph::Analysis>, Diagnostics) {
+/// One controller's plans: analysed, then checked one by one; then the
+/// checks of how the controller uses its own declarations, which need
+/// nothing from other controllers.
+fn analyse_controller<'ir>(ir: &'ir Ir, ci: CtrlId, levels: &LintLevels) -> Analysed<'ir> {
+    let c = &ir.controllers[ci.index()];
     let conditions: Vec<PlanAnalysis> = c
         .plans
         .iter()
@@ -160,7 +182,16 @@ fn analyse_controller<'ir>(
     for ((p, conditions), analysis) in c.plans.iter().zip(&conditions).zip(&graphs) {
         check_plan(ir, c, p, conditions, analysis, &mut sink);
     }
-    (conditions, graphs, diags)
+    usage::check_float_equality(c, &mut sink);
+    let uses = usage::check_unused_in_controller(ir, ci, c, &mut sink);
+    let summary = handshake::Summary::of(c, &conditions, &graphs);
+    Analysed {
+        conditions,
+        graphs,
+        summary,
+        uses,
+        diags,
+    }
 }
 
 /// The checks of one plan, over its analysis and graph.
@@ -192,23 +223,4 @@ fn check_plan(
     loops::check_livelocks(c, p, conditions, sink);
     loops::check_command_storms(ir, c, p, conditions, sink);
     index::check_index_range(ir, c, p, conditions, sink);
-}
-
-/// [`analyse_controller`] for every controller, on as many threads as the
-/// machine has: controllers are independent, and this is most of the time
-/// of the checks. Results come back in controller order, so the findings
-/// (and their order) do not depend on the threads.
-fn analyse_plans<'ir>(ir: &'ir Ir, levels: &LintLevels) -> Analysed<'ir> {
-    let plans: usize = ir.controllers.iter().map(|c| c.plans.len()).sum();
-    let per_controller =
-        crate::parallel::map_ordered(&ir.controllers, plans >= PARALLEL_PLANS, |c| {
-            analyse_controller(ir, c, levels)
-        });
-    let mut out: Analysed = (Vec::new(), Vec::new(), Vec::new());
-    for (a, g, d) in per_controller {
-        out.0.push(a);
-        out.1.push(g);
-        out.2.push(d);
-    }
-    out
 }

@@ -3,39 +3,39 @@
 use super::Sink;
 use crate::ast::BinOp;
 use crate::diagnostic::Diagnostic;
-use crate::ir::{ExprKind, Ir, Job, PlaceRoot, Target, Type};
+use crate::ir::{
+    BufferId, Controller, CtrlId, EnumId, ExprKind, Ir, Job, PlaceRoot, StatusId, Target, Type,
+};
 use crate::lint::Lint;
 
-pub(crate) fn check_float_equality(ir: &Ir, sink: &mut Sink) {
-    for c in &ir.controllers {
-        for p in &c.plans {
-            for r in &p.rows {
-                let mut found = Vec::new();
-                r.visit_exprs(&mut |e| {
-                    if let ExprKind::Binary(op @ (BinOp::Eq | BinOp::Ne), l, _) = &e.kind {
-                        if matches!(l.ty, Type::Float(_)) {
-                            found.push((*op, e.span));
-                        }
+/// `float_equality` in one controller's rows (run per controller, on the
+/// worker threads with the analyses).
+pub(crate) fn check_float_equality(c: &Controller, sink: &mut Sink) {
+    for p in &c.plans {
+        for r in &p.rows {
+            let mut found = Vec::new();
+            r.visit_exprs(&mut |e| {
+                if let ExprKind::Binary(op @ (BinOp::Eq | BinOp::Ne), l, _) = &e.kind {
+                    if matches!(l.ty, Type::Float(_)) {
+                        found.push((*op, e.span));
                     }
-                });
-                for (op, span) in found {
-                    sink.lint(
-                        Some(c),
-                        Some(p),
-                        Diagnostic::lint(
-                            Lint::FloatEquality,
-                            format!("floats compared with `{}`", op.symbol()),
-                            span,
-                            "exact float comparison",
-                        )
-                        .with_note(
-                            "measured values rarely equal a float exactly; the row may never fire",
-                        )
-                        .with_help(
-                            "compare within a tolerance: `x > goal - 0.5 && x < goal + 0.5`",
-                        ),
-                    );
                 }
+            });
+            for (op, span) in found {
+                sink.lint(
+                    Some(c),
+                    Some(p),
+                    Diagnostic::lint(
+                        Lint::FloatEquality,
+                        format!("floats compared with `{}`", op.symbol()),
+                        span,
+                        "exact float comparison",
+                    )
+                    .with_note(
+                        "measured values rarely equal a float exactly; the row may never fire",
+                    )
+                    .with_help("compare within a tolerance: `x > goal - 0.5 && x < goal + 0.5`"),
+                );
             }
         }
     }
@@ -48,7 +48,147 @@ fn mentions_type(t: &Type, f: &mut dyn FnMut(&Type)) {
     }
 }
 
-pub(crate) fn check_unused(ir: &Ir, sink: &mut Sink) {
+/// What one controller's rows use of declarations that are not its own
+/// (enums, and statuses: its own by `report`, its subordinates' by
+/// comparison), gathered per controller by [`check_unused_in_controller`]
+/// and judged for the whole set by [`check_unused_declarations`].
+#[derive(Default)]
+pub(crate) struct Uses {
+    enums: Vec<EnumId>,
+    statuses: Vec<(CtrlId, StatusId)>,
+}
+
+/// `unused` for what a controller declares for itself (vars, hooks, error
+/// codes, its `reads`/`writes` lines): decided from its own rows alone,
+/// so it runs per controller on the worker threads. Returns what the
+/// rows use of the rest of the set.
+pub(crate) fn check_unused_in_controller(
+    ir: &Ir,
+    ci: CtrlId,
+    c: &Controller,
+    sink: &mut Sink,
+) -> Uses {
+    let mut uses = Uses::default();
+    let mut var_used = vec![false; c.vars.len()];
+    let mut hook_used = vec![false; c.hooks.len()];
+    let mut error_used = vec![false; c.errors.len()];
+    // Only the buffers this controller names can be reported.
+    let mut buffer_used: Vec<(BufferId, bool)> = c
+        .reads
+        .iter()
+        .chain(&c.writes)
+        .map(|b| (*b, false))
+        .collect();
+    // A status field is published every cycle: used even if no row reads it.
+    for (v, _) in c.status_fields() {
+        var_used[v.index()] = true;
+    }
+    let mut mark_expr = |e: &crate::ir::Expr| {
+        match &e.kind {
+            ExprKind::Var(v) => var_used[v.index()] = true,
+            ExprKind::Call(h, _) => hook_used[h.index()] = true,
+            ExprKind::Buffer(b) => mark_buffer(&mut buffer_used, *b),
+            ExprKind::Variant(en, _) => uses.enums.push(*en),
+            _ => {}
+        }
+        if let (ExprKind::Status(s), Type::Status(owner)) = (&e.kind, &e.ty) {
+            uses.statuses.push((*owner, *s));
+        }
+    };
+    // The rows (conditions and jobs), then the `pre`/`post` jobs.
+    for r in c.plans.iter().flat_map(|p| &p.rows) {
+        r.visit_exprs(&mut mark_expr);
+    }
+    for b in c.pre.iter().chain(&c.post) {
+        b.visit_exprs(&mut mark_expr);
+    }
+    let rows = c.plans.iter().flat_map(|p| &p.rows);
+    for r in rows.clone() {
+        if let Target::Error(Some(e)) = r.to {
+            error_used[e.index()] = true;
+        }
+    }
+    let blocks = rows
+        .map(|r| &r.jobs)
+        .chain(c.pre.iter().chain(&c.post).map(|b| &b.jobs));
+    for j in blocks.flatten() {
+        match j {
+            Job::Assign { place, .. } => match place.root {
+                PlaceRoot::Var(v) => var_used[v.index()] = true,
+                PlaceRoot::Buffer(b) => mark_buffer(&mut buffer_used, b),
+            },
+            Job::Report { status, error, .. } => {
+                uses.statuses.push((ci, *status));
+                if let Some(e) = error {
+                    error_used[e.index()] = true;
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut report = |what: &str, name: &str, span, help: &str| {
+        sink.lint(
+            Some(c),
+            None,
+            Diagnostic::lint(
+                Lint::Unused,
+                format!("{what} `{name}` of `{}` is never used", c.name),
+                span,
+                "declared here",
+            )
+            .with_help(help.to_string()),
+        );
+    };
+    for (v, used) in c.vars.iter().zip(&var_used) {
+        if !used {
+            report("var", &v.name, v.span, "remove it, or use it in a plan");
+        }
+    }
+    for (h, used) in c.hooks.iter().zip(&hook_used) {
+        if !used {
+            report("hook", &h.name, h.span, "remove it, or call it from a row");
+        }
+    }
+    for (e, used) in c.errors.iter().zip(&error_used) {
+        if !used {
+            report(
+                "error code",
+                &e.name,
+                e.span,
+                "remove it, or end a row with `-> Error(CODE)`",
+            );
+        }
+    }
+    // Hooks see every `reads` buffer through `Data`: with hooks, an
+    // unread buffer may be theirs, so only a controller without hooks
+    // is told its `reads` buffer is unused.
+    let unread = c.reads.iter().filter(|_| c.hooks.is_empty());
+    for b in unread.chain(&c.writes) {
+        if !buffer_used.iter().any(|(id, used)| id == b && *used) {
+            let name = &ir.buffers[b.index()].name;
+            report(
+                "buffer",
+                name,
+                buffer_decl_span(c, *b),
+                "remove the `reads`/`writes` line, or use the buffer in a plan",
+            );
+        }
+    }
+    uses
+}
+
+fn mark_buffer(used: &mut [(BufferId, bool)], b: BufferId) {
+    for (id, u) in used.iter_mut() {
+        if *id == b {
+            *u = true;
+        }
+    }
+}
+
+/// `unused` for what the whole set shares: enums, buffer types, and each
+/// controller's statuses (reported by the controller itself, compared by
+/// its supervisors), from every controller's [`Uses`].
+pub(crate) fn check_unused_declarations(ir: &Ir, uses: &[Uses], sink: &mut Sink) {
     let mut enum_used = vec![false; ir.enums.len()];
     let mut btype_used = vec![false; ir.buffer_types.len()];
     let mark = |t: &Type, enum_used: &mut Vec<bool>, btype_used: &mut Vec<bool>| {
@@ -66,13 +206,12 @@ pub(crate) fn check_unused(ir: &Ir, sink: &mut Sink) {
     for b in &ir.buffers {
         btype_used[b.ty.index()] = true;
     }
-    // Statuses are used by `report` in their controller or by a supervisor's comparison.
     let mut status_used: Vec<Vec<bool>> = ir
         .controllers
         .iter()
         .map(|c| vec![false; c.statuses.len()])
         .collect();
-    for c in &ir.controllers {
+    for (c, u) in ir.controllers.iter().zip(uses) {
         for t in c
             .commands
             .iter()
@@ -88,124 +227,26 @@ pub(crate) fn check_unused(ir: &Ir, sink: &mut Sink) {
         {
             mark(t, &mut enum_used, &mut btype_used);
         }
-        let mut mark_expr = |e: &crate::ir::Expr| {
-            if let ExprKind::Variant(en, _) = e.kind {
-                enum_used[en.index()] = true;
-            }
-            if let (ExprKind::Status(s), Type::Status(owner)) = (&e.kind, &e.ty) {
-                status_used[owner.index()][s.index()] = true;
-            }
-        };
-        for p in &c.plans {
-            for r in &p.rows {
-                r.visit_exprs(&mut mark_expr);
-            }
+        for e in &u.enums {
+            enum_used[e.index()] = true;
         }
-        for b in c.pre.iter().chain(&c.post) {
-            b.visit_exprs(&mut mark_expr);
+        for (owner, s) in &u.statuses {
+            status_used[owner.index()][s.index()] = true;
         }
     }
-    for (ci, c) in ir.controllers.iter().enumerate() {
-        let mut var_used = vec![false; c.vars.len()];
-        let mut hook_used = vec![false; c.hooks.len()];
-        let mut error_used = vec![false; c.errors.len()];
-        let mut buffer_used = vec![false; ir.buffers.len()];
-        // A status field is published every cycle: used even if no row reads it.
-        for (v, _) in c.status_fields() {
-            var_used[v.index()] = true;
-        }
-        // The rows' jobs, then the `pre`/`post` jobs.
-        let rows = c.plans.iter().flat_map(|p| &p.rows);
-        let blocks = rows
-            .map(|r| (&r.jobs, Some(r)))
-            .chain(c.pre.iter().chain(&c.post).map(|b| (&b.jobs, None)));
-        for (jobs, row) in blocks {
-            let mut mark_expr = |e: &crate::ir::Expr| match &e.kind {
-                ExprKind::Var(v) => var_used[v.index()] = true,
-                ExprKind::Call(h, _) => hook_used[h.index()] = true,
-                ExprKind::Buffer(b) => buffer_used[b.index()] = true,
-                _ => {}
-            };
-            match row {
-                Some(r) => {
-                    if let Target::Error(Some(e)) = r.to {
-                        error_used[e.index()] = true;
-                    }
-                    r.visit_exprs(&mut mark_expr);
-                }
-                None => crate::ir::visit_job_exprs(jobs, &mut mark_expr),
-            }
-            for j in jobs {
-                match j {
-                    Job::Assign { place, .. } => match place.root {
-                        PlaceRoot::Var(v) => var_used[v.index()] = true,
-                        PlaceRoot::Buffer(b) => buffer_used[b.index()] = true,
-                    },
-                    Job::Report { status, error, .. } => {
-                        status_used[ci][status.index()] = true;
-                        if let Some(e) = error {
-                            error_used[e.index()] = true;
-                        }
-                    }
-                    _ => {}
-                }
-            }
-        }
-        let mut report = |what: &str, name: &str, span, help: &str| {
-            sink.lint(
-                Some(c),
-                None,
-                Diagnostic::lint(
-                    Lint::Unused,
-                    format!("{what} `{name}` of `{}` is never used", c.name),
-                    span,
-                    "declared here",
-                )
-                .with_help(help.to_string()),
-            );
-        };
-        for (v, used) in c.vars.iter().zip(&var_used) {
-            if !used {
-                report("var", &v.name, v.span, "remove it, or use it in a plan");
-            }
-        }
-        for (h, used) in c.hooks.iter().zip(&hook_used) {
-            if !used {
-                report("hook", &h.name, h.span, "remove it, or call it from a row");
-            }
-        }
-        for (e, used) in c.errors.iter().zip(&error_used) {
-            if !used {
-                report(
-                    "error code",
-                    &e.name,
-                    e.span,
-                    "remove it, or end a row with `-> Error(CODE)`",
-                );
-            }
-        }
-        for (s, used) in c.statuses.iter().zip(&status_used[ci]).skip(4) {
+    for (c, used) in ir.controllers.iter().zip(&status_used) {
+        for (s, used) in c.statuses.iter().zip(used).skip(4) {
             if let (false, Some(span)) = (used, s.span) {
-                report(
-                    "status",
-                    &s.name,
-                    span,
-                    "remove it, or `report` it from a row",
-                );
-            }
-        }
-        // Hooks see every `reads` buffer through `Data`: with hooks, an
-        // unread buffer may be theirs, so only a controller without hooks
-        // is told its `reads` buffer is unused.
-        let unread = c.reads.iter().filter(|_| c.hooks.is_empty());
-        for b in unread.chain(&c.writes) {
-            if !buffer_used[b.index()] {
-                let name = &ir.buffers[b.index()].name;
-                report(
-                    "buffer",
-                    name,
-                    buffer_decl_span(c, *b),
-                    "remove the `reads`/`writes` line, or use the buffer in a plan",
+                sink.lint(
+                    Some(c),
+                    None,
+                    Diagnostic::lint(
+                        Lint::Unused,
+                        format!("status `{}` of `{}` is never used", s.name, c.name),
+                        span,
+                        "declared here",
+                    )
+                    .with_help("remove it, or `report` it from a row"),
                 );
             }
         }

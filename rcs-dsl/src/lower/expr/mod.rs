@@ -297,7 +297,7 @@ impl Cx<'_, '_> {
                     }
                 }
             }
-            ast::ExprKind::Path(qual, name) => self.path(qual.as_ref(), name, hint, span),
+            ast::ExprKind::Path(qual, name) => self.path(qual.as_deref(), name, hint, span),
             ast::ExprKind::Call(name, args) => match crate::builtin::Builtin::from_name(&name.text)
             {
                 Some(b) => self.builtin(b, args, hint, span),

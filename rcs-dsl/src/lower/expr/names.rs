@@ -14,7 +14,7 @@ impl Cx<'_, '_> {
     /// anything else is a run-time value of an integer type.
     pub(in crate::lower) fn index(&mut self, idx: &ast::Expr) -> Option<Subscript> {
         match &idx.kind {
-            ast::ExprKind::Int(n) => Some(Subscript::Const(*n as u64)),
+            ast::ExprKind::Int(n) => Some(Subscript::Const(*n)),
             ast::ExprKind::Paren(inner) => self.index(inner),
             _ => {
                 let (mut x, t) = self.infer(idx, None);

@@ -224,7 +224,7 @@ impl Builder {
         let mut height = 1;
         let kind = match p.as_rule() {
             Rule::number if p.as_str().contains(['.', 'e', 'E']) => {
-                match p.as_str().replace('_', "").parse::<f64>() {
+                match without_underscores(p.as_str()).parse::<f64>() {
                     Ok(v) if v.is_finite() => ExprKind::Float(v),
                     _ => {
                         self.error(span, "float literal is out of range", "not a finite f64");
@@ -232,8 +232,8 @@ impl Builder {
                     }
                 }
             }
-            Rule::number => match p.as_str().replace('_', "").parse::<u128>() {
-                Ok(v) if v <= u64::MAX as u128 => ExprKind::Int(v),
+            Rule::number => match without_underscores(p.as_str()).parse::<u64>() {
+                Ok(v) => ExprKind::Int(v),
                 _ => {
                     self.error(
                         span,
@@ -269,12 +269,12 @@ impl Builder {
                             .map(|a| self.expr_at(a, depth + 1))
                             .collect();
                         height = 2;
-                        ExprKind::Call(name, args)
+                        ExprKind::Call(Box::new(name), args)
                     }
                     (_, Some(_)) => {
                         let qualifier = self.name(first);
                         let name = self.name(inner.next().expect("variant"));
-                        ExprKind::Path(Some(qualifier), name)
+                        ExprKind::Path(Some(Box::new(qualifier)), name)
                     }
                     (_, None) => ExprKind::Path(None, self.name(first)),
                 }

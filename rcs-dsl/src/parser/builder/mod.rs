@@ -37,7 +37,7 @@ impl Builder {
             text: p.as_str().into(),
             span: self.span(&p),
         };
-        if RESERVED.contains(&name.text.as_str()) {
+        if is_reserved(&name.text) {
             let help = match name.text.as_str() {
                 "cmd" => "read a command parameter as `cmd.NAME`".to_string(),
                 _ => format!(
@@ -70,7 +70,7 @@ impl Builder {
 
     pub(in crate::parser) fn int(&mut self, p: Pair<Rule>) -> u64 {
         let span = self.span(&p);
-        match p.as_str().replace('_', "").parse::<u64>() {
+        match without_underscores(p.as_str()).parse::<u64>() {
             Ok(v) => v,
             Err(_) => {
                 self.error(
@@ -180,6 +180,39 @@ pub const RESERVED: [&str; 24] = [
     "plan_cycles",
 ];
 
+/// Whether `s` is in [`RESERVED`]: a `match` (a jump on the length, then
+/// one comparison) rather than a scan of the list, as every name of a
+/// plan set passes here.
+fn is_reserved(s: &str) -> bool {
+    matches!(
+        s,
+        "enum"
+            | "buffer"
+            | "controller"
+            | "level"
+            | "subordinates"
+            | "reads"
+            | "writes"
+            | "command"
+            | "status"
+            | "error"
+            | "var"
+            | "hook"
+            | "plan"
+            | "when"
+            | "otherwise"
+            | "report"
+            | "true"
+            | "false"
+            | "same"
+            | "as"
+            | "new_command"
+            | "cmd"
+            | "state_cycles"
+            | "plan_cycles"
+    )
+}
+
 fn bin_op(s: &str) -> BinOp {
     match s {
         "||" => BinOp::Or,
@@ -195,6 +228,16 @@ fn bin_op(s: &str) -> BinOp {
         "*" => BinOp::Mul,
         "/" => BinOp::Div,
         _ => BinOp::Rem,
+    }
+}
+
+/// A number's digits without its `_` separators (borrowed when it has
+/// none, as most do: no allocation per literal).
+fn without_underscores(s: &str) -> std::borrow::Cow<'_, str> {
+    if s.contains('_') {
+        std::borrow::Cow::Owned(s.replace('_', ""))
+    } else {
+        std::borrow::Cow::Borrowed(s)
     }
 }
 
@@ -214,4 +257,30 @@ fn unescape(s: &str) -> String {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn is_reserved_is_the_reserved_list() {
+        for w in super::RESERVED {
+            assert!(super::is_reserved(w), "{w}");
+        }
+        let count = |s: &str| super::RESERVED.iter().filter(|w| **w == s).count();
+        for w in [
+            "C1", "acc", "enums", "Status", "cmd_", "plans", "asx", "", "reports",
+        ] {
+            assert_eq!(super::is_reserved(w), count(w) == 1, "{w}");
+        }
+        // Every word of the match is in the list: as many as the list has.
+        let words = include_str!("mod.rs")
+            .split("fn is_reserved")
+            .nth(1)
+            .and_then(|rest| rest.split("fn bin_op").next())
+            .expect("the match")
+            .matches("\"")
+            .count()
+            / 2;
+        assert_eq!(words, super::RESERVED.len());
+    }
 }

@@ -446,7 +446,7 @@ impl PlanAnalysis<'_> {
                     if let (Some(c), true) =
                         (&self.conds[j], covers(&self.plan.rows[j].from, state))
                     {
-                        parts.push(Formula::Not(Box::new(Formula::Shared(c.clone()))));
+                        parts.push(Formula::NotShared(c.clone()));
                     }
                 }
             }

@@ -414,14 +414,27 @@ impl<'ir> PlanAnalysis<'ir> {
         if let Some(&never) = self.proved.borrow().get(&q) {
             return never;
         }
-        let (f, fixed, _) = self.question(q);
-        let never = matches!(self.prove(&f, &fixed), Outcome::None);
+        // What `fixed` gives, without a vector per question.
+        let (f, state) = self.question_formula(q);
+        let no_new_command = [(self.new_command, Value::Bool(false))];
+        let fixed: &[(LeafId, Value)] = if state == StateId::S0 {
+            &[]
+        } else {
+            &no_new_command
+        };
+        let never = matches!(self.prove(&f, fixed), Outcome::None);
         self.proved.borrow_mut().insert(q, never);
         never
     }
 
     /// A question as a formula, the leaves it fixes, and its state.
     fn question(&self, q: Question) -> (Formula, Vec<(LeafId, Value)>, StateId) {
+        let (f, state) = self.question_formula(q);
+        (f, self.fixed(state), state)
+    }
+
+    /// A question as a formula, and its state.
+    fn question_formula(&self, q: Question) -> (Formula, StateId) {
         let cond = |i: usize| match &self.conds[i] {
             Some(c) => Formula::Shared(c.clone()),
             None => Formula::Const(true),
@@ -432,18 +445,18 @@ impl<'ir> PlanAnalysis<'ir> {
                     From::State(s) => s,
                     From::DontCare(_) => StateId::S0,
                 };
-                (cond(row), self.fixed(state), state)
+                (cond(row), state)
             }
             Question::FiresIn(row, state) => {
                 let f = self.fires(row, state).unwrap_or(Formula::Const(false));
-                (f, self.fixed(state), state)
+                (f, state)
             }
             Question::FiresWhile(row, other, state) => {
                 let f = match self.fires(row, state) {
                     Some(fires) => Formula::And(vec![fires, cond(other)]),
                     None => Formula::Const(false),
                 };
-                (f, self.fixed(state), state)
+                (f, state)
             }
         }
     }
@@ -471,7 +484,7 @@ impl<'ir> PlanAnalysis<'ir> {
         };
         for i in others.filter(|&i| i != row) {
             if let (Some(c), true) = (&self.conds[i], covers(&self.plan.rows[i].from, state)) {
-                parts.push(Formula::Not(Box::new(Formula::Shared(c.clone()))));
+                parts.push(Formula::NotShared(c.clone()));
             }
         }
         Some(Formula::And(parts))

@@ -238,6 +238,7 @@ impl<'a> Search<'a> {
             Formula::Atom(a) => self.atom(*a),
             Formula::Not(x) => self.value(x).map(|b| !b),
             Formula::Shared(x) => self.value(x),
+            Formula::NotShared(x) => self.value(x).map(|b| !b),
             Formula::And(xs) => {
                 let mut all = Some(true);
                 for x in xs {

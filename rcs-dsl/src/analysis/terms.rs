@@ -55,6 +55,9 @@ pub enum Formula {
     Or(Vec<Formula>),
     /// A formula shared between questions (a row's condition), not copied.
     Shared(std::sync::Arc<Formula>),
+    /// The negation of a shared formula (an earlier row's condition, which
+    /// a later row's firing needs false): no box per question.
+    NotShared(std::sync::Arc<Formula>),
 }
 
 impl Formula {
@@ -65,7 +68,7 @@ impl Formula {
             Formula::Atom(a) => f(*a),
             Formula::Not(x) => x.visit_atoms(f),
             Formula::And(xs) | Formula::Or(xs) => xs.iter().for_each(|x| x.visit_atoms(f)),
-            Formula::Shared(x) => x.visit_atoms(f),
+            Formula::Shared(x) | Formula::NotShared(x) => x.visit_atoms(f),
         }
     }
 }

@@ -72,72 +72,70 @@ pub(crate) fn check_unhandled_error(
     sink: &mut Sink,
 ) {
     let c = ir.controller(ci);
-    {
-        for (pi, p) in c.plans.iter().enumerate() {
-            let conditions = &conditions[pi];
-            let graph = &graphs[pi];
-            // A plan too large to analyse: nothing can be proved of it.
-            if !conditions.analysed() {
+    for (pi, p) in c.plans.iter().enumerate() {
+        let conditions = &conditions[pi];
+        let graph = &graphs[pi];
+        // A plan too large to analyse: nothing can be proved of it.
+        if !conditions.analysed() {
+            continue;
+        }
+        // Paths to each state, searched once a finding needs one.
+        let paths = std::cell::OnceCell::new();
+        for &x in &c.subordinates {
+            // The verbs this plan sends X, and a row of X's plans for
+            // them that can end in Error.
+            let sent = verbs_sent(&p.rows, x);
+            let Some(fails) = sent.iter().find_map(|v| error_row(ir, summaries, x, *v)) else {
                 continue;
-            }
-            // Paths to each state, searched once a finding needs one.
-            let paths = std::cell::OnceCell::new();
-            for &x in &c.subordinates {
-                // The verbs this plan sends X, and a row of X's plans for
-                // them that can end in Error.
-                let sent = verbs_sent(&p.rows, x);
-                let Some(fails) = sent.iter().find_map(|v| error_row(ir, summaries, x, *v)) else {
+            };
+            for s in (0..p.states.len()).filter(|s| graph.reachable[*s]) {
+                let state = StateId(s as u32);
+                let waiting: Vec<&Row> = p
+                    .rows
+                    .iter()
+                    .filter(|r| covers(&r.from, state) && waits_for_done(r, x))
+                    .filter(|r| !conditions.never_fires_in(r.position as usize, state))
+                    .collect();
+                let Some(first) = waiting.first() else {
                     continue;
                 };
-                for s in (0..p.states.len()).filter(|s| graph.reachable[*s]) {
-                    let state = StateId(s as u32);
-                    let waiting: Vec<&Row> = p
-                        .rows
-                        .iter()
-                        .filter(|r| covers(&r.from, state) && waits_for_done(r, x))
-                        .filter(|r| !conditions.never_fires_in(r.position as usize, state))
-                        .collect();
-                    let Some(first) = waiting.first() else {
-                        continue;
-                    };
-                    let Some(w) = conditions.stalls_in(state, x, StatusId::ERROR) else {
-                        continue;
-                    };
-                    let paths = paths.get_or_init(|| conditions.paths());
-                    let run = conditions.stall_run(paths, state, &w, STALL_CYCLES);
-                    let sub = &ir.controller(x).name;
-                    let state_name = &p.states[s].name;
-                    let verb = &c.plan_title(p);
-                    let (xp, xr) = fails;
-                    let x_ctrl = ir.controller(x);
-                    let x_verb = &x_ctrl.plan_title(&x_ctrl.plans[xp]);
-                    let x_row = &x_ctrl.plans[xp].rows[xr];
-                    let d = Diagnostic::lint(
-                        Lint::UnhandledError,
-                        format!(
-                            "state `{state_name}` of plan `{verb}` waits for `{sub}.done`, \
-                             but nothing handles `{sub}.error`"
-                        ),
-                        first.cond_span,
-                        format!("waits for `{sub}.done`"),
-                    )
-                    .with_secondary(
-                        x_row.span,
-                        format!("`{sub}`'s plan `{x_verb}` can end in `Error` here"),
-                    )
-                    .with_witness(state_name, &w.shown)
-                    .with_run(run)
-                    .with_note(format!(
-                        "with `{sub}.status == ERROR` no row of `{state_name}` matches, whatever \
-                         the other inputs: `{}` stays in `{state_name}` until a new command",
-                        c.name
-                    ))
-                    .with_help(format!(
-                        "handle the failure: a row such as `*N when {sub}.error -> Error(CODE)`, \
-                         or a timeout (`{state_name} when state_cycles > N -> …`)"
-                    ));
-                    sink.lint(Some(c), Some(p), d);
-                }
+                let Some(w) = conditions.stalls_in(state, x, StatusId::ERROR) else {
+                    continue;
+                };
+                let paths = paths.get_or_init(|| conditions.paths());
+                let run = conditions.stall_run(paths, state, &w, STALL_CYCLES);
+                let sub = &ir.controller(x).name;
+                let state_name = &p.states[s].name;
+                let verb = &c.plan_title(p);
+                let (xp, xr) = fails;
+                let x_ctrl = ir.controller(x);
+                let x_verb = &x_ctrl.plan_title(&x_ctrl.plans[xp]);
+                let x_row = &x_ctrl.plans[xp].rows[xr];
+                let d = Diagnostic::lint(
+                    Lint::UnhandledError,
+                    format!(
+                        "state `{state_name}` of plan `{verb}` waits for `{sub}.done`, \
+                         but nothing handles `{sub}.error`"
+                    ),
+                    first.cond_span,
+                    format!("waits for `{sub}.done`"),
+                )
+                .with_secondary(
+                    x_row.span,
+                    format!("`{sub}`'s plan `{x_verb}` can end in `Error` here"),
+                )
+                .with_witness(state_name, &w.shown)
+                .with_run(run)
+                .with_note(format!(
+                    "with `{sub}.status == ERROR` no row of `{state_name}` matches, whatever \
+                     the other inputs: `{}` stays in `{state_name}` until a new command",
+                    c.name
+                ))
+                .with_help(format!(
+                    "handle the failure: a row such as `*N when {sub}.error -> Error(CODE)`, \
+                     or a timeout (`{state_name} when state_cycles > N -> …`)"
+                ));
+                sink.lint(Some(c), Some(p), d);
             }
         }
     }
@@ -200,40 +198,39 @@ pub(crate) fn check_status_never_reported(
     sink: &mut Sink,
 ) {
     let c = ir.controller(ci);
-    {
-        for &x in &c.subordinates {
-            // One supervisor only commands X (two is an error of its own).
-            if ir.controller(x).supervisor != Some(ci) {
-                continue;
-            }
-            let sent: Vec<CommandId> = c.plans.iter().flat_map(|p| verbs_sent(&p.rows, x)).fold(
-                Vec::new(),
-                |mut vs, v| {
+    for &x in &c.subordinates {
+        // One supervisor only commands X (two is an error of its own).
+        if ir.controller(x).supervisor != Some(ci) {
+            continue;
+        }
+        let sent: Vec<CommandId> =
+            c.plans
+                .iter()
+                .flat_map(|p| verbs_sent(&p.rows, x))
+                .fold(Vec::new(), |mut vs, v| {
                     if !vs.contains(&v) {
                         vs.push(v);
                     }
                     vs
-                },
-            );
-            let Some(reported) = statuses_reported(ir, summaries, x, &sent) else {
-                continue;
-            };
-            for p in &c.plans {
-                for r in &p.rows {
-                    for (status, span) in status_tests(r, x) {
-                        // ERROR is not judged: testing it is the
-                        // defensive handling `unhandled_error` asks for,
-                        // worth keeping when X's plans change.
-                        if status == StatusId::NOT_READY
-                            || status == StatusId::EXECUTING
-                            || status == StatusId::ERROR
-                            || reported.contains(&status)
-                        {
-                            continue;
-                        }
-                        let d = never_reported(ir, c, x, &sent, status, span);
-                        sink.lint(Some(c), Some(p), d);
+                });
+        let Some(reported) = statuses_reported(ir, summaries, x, &sent) else {
+            continue;
+        };
+        for p in &c.plans {
+            for r in &p.rows {
+                for (status, span) in status_tests(r, x) {
+                    // ERROR is not judged: testing it is the
+                    // defensive handling `unhandled_error` asks for,
+                    // worth keeping when X's plans change.
+                    if status == StatusId::NOT_READY
+                        || status == StatusId::EXECUTING
+                        || status == StatusId::ERROR
+                        || reported.contains(&status)
+                    {
+                        continue;
                     }
+                    let d = never_reported(ir, c, x, &sent, status, span);
+                    sink.lint(Some(c), Some(p), d);
                 }
             }
         }
@@ -319,24 +316,21 @@ fn reported_by(plan: &Plan, conditions: &PlanAnalysis, graph: &Analysis) -> Vec<
             reported.push(s);
         }
     };
-    {
-        for (i, r) in plan.rows.iter().enumerate() {
-            let can_fire = !graph.never_matches[i]
-                && (0..plan.states.len()).any(|s| {
-                    graph.reachable[s] && !conditions.never_fires_in(i, StateId(s as u32))
-                });
-            if !can_fire {
-                continue;
-            }
-            match r.to {
-                Target::Done => add(StatusId::DONE),
-                Target::Error(_) => add(StatusId::ERROR),
-                Target::State(_) | Target::Same => {}
-            }
-            for j in &r.jobs {
-                if let Job::Report { status, .. } = j {
-                    add(*status);
-                }
+    for (i, r) in plan.rows.iter().enumerate() {
+        let can_fire = !graph.never_matches[i]
+            && (0..plan.states.len())
+                .any(|s| graph.reachable[s] && !conditions.never_fires_in(i, StateId(s as u32)));
+        if !can_fire {
+            continue;
+        }
+        match r.to {
+            Target::Done => add(StatusId::DONE),
+            Target::Error(_) => add(StatusId::ERROR),
+            Target::State(_) | Target::Same => {}
+        }
+        for j in &r.jobs {
+            if let Job::Report { status, .. } = j {
+                add(*status);
             }
         }
     }

@@ -468,7 +468,7 @@ impl PlanAnalysis<'_> {
         if state == StateId::S0 {
             return None;
         }
-        let super::Answer::Can(free) = self.decide(f, &self.fixed(state), state) else {
+        let super::Answer::Can(free) = self.decide(f, self.known(state).as_slice(), state) else {
             return None;
         };
         let given: Vec<_> = free

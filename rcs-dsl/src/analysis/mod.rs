@@ -414,15 +414,8 @@ impl<'ir> PlanAnalysis<'ir> {
         if let Some(&never) = self.proved.borrow().get(&q) {
             return never;
         }
-        // What `fixed` gives, without a vector per question.
         let (f, state) = self.question_formula(q);
-        let no_new_command = [(self.new_command, Value::Bool(false))];
-        let fixed: &[(LeafId, Value)] = if state == StateId::S0 {
-            &[]
-        } else {
-            &no_new_command
-        };
-        let never = matches!(self.prove(&f, fixed), Outcome::None);
+        let never = matches!(self.prove(&f, self.known(state).as_slice()), Outcome::None);
         self.proved.borrow_mut().insert(q, never);
         never
     }
@@ -490,13 +483,14 @@ impl<'ir> PlanAnalysis<'ir> {
         Some(Formula::And(parts))
     }
 
-    /// What is known of a cycle in `state`: outside `S0`, no new command.
+    /// What is known of a cycle in `state`, as a vector its callers extend.
     fn fixed(&self, state: StateId) -> Vec<(LeafId, Value)> {
-        if state == StateId::S0 {
-            Vec::new()
-        } else {
-            vec![(self.new_command, Value::Bool(false))]
-        }
+        self.known(state).into_iter().collect()
+    }
+
+    /// What is known of a cycle in `state`: outside `S0`, no new command.
+    fn known(&self, state: StateId) -> Option<(LeafId, Value)> {
+        (state != StateId::S0).then_some((self.new_command, Value::Bool(false)))
     }
 
     /// The values a witness search tries, made on first use.

@@ -183,7 +183,7 @@ fn analyse_controller<'ir>(ir: &'ir Ir, ci: CtrlId, levels: &LintLevels) -> Anal
         check_plan(ir, c, p, conditions, analysis, &mut sink);
     }
     usage::check_float_equality(c, &mut sink);
-    let uses = usage::check_unused_in_controller(ir, ci, c, &mut sink);
+    let uses = usage::check_unused_in_controller(ir, ci, &mut sink);
     let summary = handshake::Summary::of(c, &conditions, &graphs);
     Analysed {
         conditions,

@@ -3,9 +3,7 @@
 use super::Sink;
 use crate::ast::BinOp;
 use crate::diagnostic::Diagnostic;
-use crate::ir::{
-    BufferId, Controller, CtrlId, EnumId, ExprKind, Ir, Job, PlaceRoot, StatusId, Target, Type,
-};
+use crate::ir::{Controller, CtrlId, EnumId, ExprKind, Ir, Job, PlaceRoot, StatusId, Target, Type};
 use crate::lint::Lint;
 
 /// `float_equality` in one controller's rows (run per controller, on the
@@ -62,23 +60,13 @@ pub(crate) struct Uses {
 /// codes, its `reads`/`writes` lines): decided from its own rows alone,
 /// so it runs per controller on the worker threads. Returns what the
 /// rows use of the rest of the set.
-pub(crate) fn check_unused_in_controller(
-    ir: &Ir,
-    ci: CtrlId,
-    c: &Controller,
-    sink: &mut Sink,
-) -> Uses {
+pub(crate) fn check_unused_in_controller(ir: &Ir, ci: CtrlId, sink: &mut Sink) -> Uses {
+    let c = ir.controller(ci);
     let mut uses = Uses::default();
     let mut var_used = vec![false; c.vars.len()];
     let mut hook_used = vec![false; c.hooks.len()];
     let mut error_used = vec![false; c.errors.len()];
-    // Only the buffers this controller names can be reported.
-    let mut buffer_used: Vec<(BufferId, bool)> = c
-        .reads
-        .iter()
-        .chain(&c.writes)
-        .map(|b| (*b, false))
-        .collect();
+    let mut buffer_used = vec![false; ir.buffers.len()];
     // A status field is published every cycle: used even if no row reads it.
     for (v, _) in c.status_fields() {
         var_used[v.index()] = true;
@@ -87,7 +75,7 @@ pub(crate) fn check_unused_in_controller(
         match &e.kind {
             ExprKind::Var(v) => var_used[v.index()] = true,
             ExprKind::Call(h, _) => hook_used[h.index()] = true,
-            ExprKind::Buffer(b) => mark_buffer(&mut buffer_used, *b),
+            ExprKind::Buffer(b) => buffer_used[b.index()] = true,
             ExprKind::Variant(en, _) => uses.enums.push(*en),
             _ => {}
         }
@@ -115,7 +103,7 @@ pub(crate) fn check_unused_in_controller(
         match j {
             Job::Assign { place, .. } => match place.root {
                 PlaceRoot::Var(v) => var_used[v.index()] = true,
-                PlaceRoot::Buffer(b) => mark_buffer(&mut buffer_used, b),
+                PlaceRoot::Buffer(b) => buffer_used[b.index()] = true,
             },
             Job::Report { status, error, .. } => {
                 uses.statuses.push((ci, *status));
@@ -164,7 +152,7 @@ pub(crate) fn check_unused_in_controller(
     // is told its `reads` buffer is unused.
     let unread = c.reads.iter().filter(|_| c.hooks.is_empty());
     for b in unread.chain(&c.writes) {
-        if !buffer_used.iter().any(|(id, used)| id == b && *used) {
+        if !buffer_used[b.index()] {
             let name = &ir.buffers[b.index()].name;
             report(
                 "buffer",
@@ -175,14 +163,6 @@ pub(crate) fn check_unused_in_controller(
         }
     }
     uses
-}
-
-fn mark_buffer(used: &mut [(BufferId, bool)], b: BufferId) {
-    for (id, u) in used.iter_mut() {
-        if *id == b {
-            *u = true;
-        }
-    }
 }
 
 /// `unused` for what the whole set shares: enums, buffer types, and each

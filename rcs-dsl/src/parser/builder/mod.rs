@@ -37,7 +37,7 @@ impl Builder {
             text: p.as_str().into(),
             span: self.span(&p),
         };
-        if is_reserved(&name.text) {
+        if RESERVED.contains(&name.text.as_str()) {
             let help = match name.text.as_str() {
                 "cmd" => "read a command parameter as `cmd.NAME`".to_string(),
                 _ => format!(
@@ -180,39 +180,6 @@ pub const RESERVED: [&str; 24] = [
     "plan_cycles",
 ];
 
-/// Whether `s` is in [`RESERVED`]: a `match` (a jump on the length, then
-/// one comparison) rather than a scan of the list, as every name of a
-/// plan set passes here.
-fn is_reserved(s: &str) -> bool {
-    matches!(
-        s,
-        "enum"
-            | "buffer"
-            | "controller"
-            | "level"
-            | "subordinates"
-            | "reads"
-            | "writes"
-            | "command"
-            | "status"
-            | "error"
-            | "var"
-            | "hook"
-            | "plan"
-            | "when"
-            | "otherwise"
-            | "report"
-            | "true"
-            | "false"
-            | "same"
-            | "as"
-            | "new_command"
-            | "cmd"
-            | "state_cycles"
-            | "plan_cycles"
-    )
-}
-
 fn bin_op(s: &str) -> BinOp {
     match s {
         "||" => BinOp::Or,
@@ -257,30 +224,4 @@ fn unescape(s: &str) -> String {
         }
     }
     out
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn is_reserved_is_the_reserved_list() {
-        for w in super::RESERVED {
-            assert!(super::is_reserved(w), "{w}");
-        }
-        let count = |s: &str| super::RESERVED.iter().filter(|w| **w == s).count();
-        for w in [
-            "C1", "acc", "enums", "Status", "cmd_", "plans", "asx", "", "reports",
-        ] {
-            assert_eq!(super::is_reserved(w), count(w) == 1, "{w}");
-        }
-        // Every word of the match is in the list: as many as the list has.
-        let words = include_str!("mod.rs")
-            .split("fn is_reserved")
-            .nth(1)
-            .and_then(|rest| rest.split("fn bin_op").next())
-            .expect("the match")
-            .matches("\"")
-            .count()
-            / 2;
-        assert_eq!(words, super::RESERVED.len());
-    }
 }

@@ -342,7 +342,8 @@ pub enum ExprKind {
     Field(Box<Expr>, Name),
     Index(Box<Expr>, Box<Expr>),
     Unary(UnOp, Box<Expr>),
-    Binary(BinOp, Box<Expr>, Box<Expr>),
+    /// Both operands in one allocation, left then right (as in the IR).
+    Binary(BinOp, Box<[Expr; 2]>),
     Cast(Box<Expr>, Name),
     Paren(Box<Expr>),
 }

@@ -566,7 +566,10 @@ pub enum ExprKind {
     /// `X.status`, `X.done`, … seen through the handshake.
     Sub(CtrlId, SubProp),
     Unary(UnOp, Box<Expr>),
-    Binary(BinOp, Box<Expr>, Box<Expr>),
+    /// Both operands in one allocation, left then right: binary operators
+    /// are most of the nodes of a condition, and a box per operand made the
+    /// IR's expressions two allocations per operator to build and to free.
+    Binary(BinOp, Box<[Expr; 2]>),
     Cast(Box<Expr>),
     /// A built-in function (`abs`, `sqrt`, …): pure, arguments of one type
     /// (see [`crate::builtin`]).
@@ -657,6 +660,13 @@ impl Controller {
     }
 }
 
+impl ExprKind {
+    /// `l op r`.
+    pub fn binary(op: BinOp, l: Expr, r: Expr) -> ExprKind {
+        ExprKind::Binary(op, Box::new([l, r]))
+    }
+}
+
 impl Expr {
     /// Call `f` on this expression and every sub-expression, parents first.
     pub fn visit<'a>(&'a self, f: &mut dyn FnMut(&'a Expr)) {
@@ -666,7 +676,8 @@ impl Expr {
             | ExprKind::Index(e, _)
             | ExprKind::Unary(_, e)
             | ExprKind::Cast(e) => e.visit(f),
-            ExprKind::Binary(_, l, r) | ExprKind::IndexBy(l, r) => {
+            ExprKind::Binary(_, operands) => operands.iter().for_each(|e| e.visit(f)),
+            ExprKind::IndexBy(l, r) => {
                 l.visit(f);
                 r.visit(f);
             }

@@ -114,7 +114,8 @@ impl<'a> Printer<'a> {
                 out.push(if *op == UnOp::Not { '!' } else { '-' });
                 self.write(x, UNARY, out);
             }
-            ExprKind::Binary(op, l, r) => {
+            ExprKind::Binary(op, operands) => {
+                let [l, r] = &**operands;
                 let p = op.precedence();
                 // Left-associative: the right operand needs parentheses at equal strength.
                 self.write(l, p, out);

@@ -129,7 +129,8 @@ fn collect_calls(e: &Expr, f: &mut dyn FnMut(HookId, &[Expr])) {
         | ExprKind::Index(x, _)
         | ExprKind::Unary(_, x)
         | ExprKind::Cast(x) => collect_calls(x, f),
-        ExprKind::Binary(_, l, r) | ExprKind::IndexBy(l, r) => {
+        ExprKind::Binary(_, operands) => operands.iter().for_each(|x| collect_calls(x, f)),
+        ExprKind::IndexBy(l, r) => {
             collect_calls(l, f);
             collect_calls(r, f);
         }
@@ -367,7 +368,10 @@ impl Gen<'_> {
                     has_block: c.has_block,
                 }
             }
-            ExprKind::Binary(op, l, r) => self.binary(*op, l, r),
+            ExprKind::Binary(op, operands) => {
+                let [l, r] = &**operands;
+                self.binary(*op, l, r)
+            }
             ExprKind::Builtin(b, args) => {
                 let codes: Vec<Code> = args.iter().map(|a| self.expr(a)).collect();
                 let ty = args.first().map_or(&e.ty, |a| &a.ty);
@@ -534,12 +538,12 @@ impl Gen<'_> {
     fn self_update<'e>(&self, place: &Place, value: &'e Expr) -> Option<(BinOp, &'e Expr)> {
         let ExprKind::Binary(
             op @ (BinOp::Add | BinOp::Sub | BinOp::Mul | BinOp::Div | BinOp::Rem),
-            l,
-            r,
+            operands,
         ) = &value.kind
         else {
             return None;
         };
+        let [l, r] = &**operands;
         same_place(place, l).then_some((*op, r))
     }
 

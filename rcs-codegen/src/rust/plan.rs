@@ -18,7 +18,9 @@ use rcs_dsl::pretty::Printer;
 fn starts_with_new_command(e: &Expr) -> bool {
     match &e.kind {
         ExprKind::NewCommand => true,
-        ExprKind::Binary(rcs_dsl::ast::BinOp::And, l, _) => starts_with_new_command(l),
+        ExprKind::Binary(rcs_dsl::ast::BinOp::And, operands) => {
+            starts_with_new_command(&operands[0])
+        }
         _ => false,
     }
 }

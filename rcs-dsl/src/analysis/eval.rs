@@ -42,7 +42,10 @@ pub fn eval(e: &Expr, leaf: &dyn Fn(&Leaf) -> Option<Value>) -> Option<Value> {
         },
         ExprKind::Unary(op, x) => arith::unary(*op, eval(x, leaf)?, &e.ty),
         ExprKind::Cast(x) => arith::cast(eval(x, leaf)?, &e.ty),
-        ExprKind::Binary(op, l, r) => arith::binary(*op, eval(l, leaf)?, eval(r, leaf)?, &e.ty),
+        ExprKind::Binary(op, operands) => {
+            let [l, r] = &**operands;
+            arith::binary(*op, eval(l, leaf)?, eval(r, leaf)?, &e.ty)
+        }
         ExprKind::Builtin(b, args) => {
             let values = args
                 .iter()

@@ -209,14 +209,14 @@ fn out_formula(
         return None;
     }
     let cmp = |op: BinOp, n: i128| Expr {
-        kind: ExprKind::Binary(
+        kind: ExprKind::binary(
             op,
-            Box::new(index.clone()),
-            Box::new(Expr {
+            index.clone(),
+            Expr {
                 kind: ExprKind::Int(n),
                 ty: index.ty.clone(),
                 span: index.span,
-            }),
+            },
         ),
         ty: Type::Bool,
         span: index.span,
@@ -248,7 +248,8 @@ fn in_condition<'ir>(
     match &e.kind {
         ExprKind::Bool(_) => {}
         ExprKind::Unary(crate::ast::UnOp::Not, x) => in_condition(terms, printer, x, guard, out),
-        ExprKind::Binary(op @ (BinOp::And | BinOp::Or), l, r) => {
+        ExprKind::Binary(op @ (BinOp::And | BinOp::Or), operands) => {
+            let [l, r] = &**operands;
             in_condition(terms, printer, l, guard.clone(), out);
             let left = terms.formula(l);
             let mut g = guard;
@@ -273,7 +274,8 @@ fn in_atom(
     out: &mut Vec<Met>,
 ) {
     match &e.kind {
-        ExprKind::Binary(BinOp::And | BinOp::Or, l, r) => {
+        ExprKind::Binary(BinOp::And | BinOp::Or, operands) => {
+            let [l, r] = &**operands;
             in_atom(printer, l, guard, out);
             in_atom(printer, r, None, out);
         }
@@ -294,7 +296,8 @@ fn in_atom(
         | ExprKind::Index(x, _)
         | ExprKind::Unary(_, x)
         | ExprKind::Cast(x) => in_atom(printer, x, guard, out),
-        ExprKind::Binary(_, l, r) => {
+        ExprKind::Binary(_, operands) => {
+            let [l, r] = &**operands;
             in_atom(printer, l, guard, out);
             in_atom(printer, r, guard, out);
         }

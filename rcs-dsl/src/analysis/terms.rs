@@ -144,7 +144,8 @@ impl<'ir> Terms<'ir> {
     /// The operands of a chain of `op` (left to right), as formulas.
     fn chain(&mut self, e: &'ir Expr, op: BinOp, out: &mut Vec<Formula>) {
         match &e.kind {
-            ExprKind::Binary(o, l, r) if *o == op => {
+            ExprKind::Binary(o, operands) if *o == op => {
+                let [l, r] = &**operands;
                 self.chain(l, op, out);
                 self.chain(r, op, out);
             }
@@ -191,9 +192,10 @@ impl<'ir> Terms<'ir> {
                     // A bool leaf, or `X.done`-style view of a status leaf.
                     return Some(None);
                 }
-                let ExprKind::Binary(op, l, r) = &e.kind else {
+                let ExprKind::Binary(op, operands) = &e.kind else {
                     return None;
                 };
+                let [l, r] = &**operands;
                 if !matches!(
                     op,
                     BinOp::Eq | BinOp::Ne | BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge
@@ -212,7 +214,7 @@ impl<'ir> Terms<'ir> {
                 ) {
                     return None;
                 }
-                Some(Some(&**constant))
+                Some(Some(constant))
             }
             _ => None,
         }
@@ -263,7 +265,8 @@ impl<'ir> Terms<'ir> {
                 self.collect_leaves(i, out, scalar);
             }
             ExprKind::Unary(_, x) | ExprKind::Cast(x) => self.collect_leaves(x, out, scalar),
-            ExprKind::Binary(_, l, r) => {
+            ExprKind::Binary(_, operands) => {
+                let [l, r] = &**operands;
                 self.collect_leaves(l, out, scalar);
                 self.collect_leaves(r, out, scalar);
             }

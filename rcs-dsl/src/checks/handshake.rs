@@ -179,7 +179,8 @@ fn is_done_test(e: &Expr, x: CtrlId) -> bool {
     let done = |e: &Expr| matches!(e.kind, ExprKind::Status(s) if s == StatusId::DONE);
     match &e.kind {
         ExprKind::Sub(c, SubProp::Done) => *c == x,
-        ExprKind::Binary(BinOp::Eq, l, r) => {
+        ExprKind::Binary(BinOp::Eq, operands) => {
+            let [l, r] = &**operands;
             (status_of_x(l) && done(r)) || (done(l) && status_of_x(r))
         }
         _ => false,
@@ -357,11 +358,13 @@ fn waits_in(e: &Expr, x: CtrlId, found: &mut Vec<(StatusId, crate::source::Span)
     match &e.kind {
         ExprKind::Sub(c, SubProp::Done) if *c == x => found.push((StatusId::DONE, e.span)),
         ExprKind::Sub(c, SubProp::Error) if *c == x => found.push((StatusId::ERROR, e.span)),
-        ExprKind::Binary(BinOp::And | BinOp::Or, l, r) => {
+        ExprKind::Binary(BinOp::And | BinOp::Or, operands) => {
+            let [l, r] = &**operands;
             waits_in(l, x, found);
             waits_in(r, x, found);
         }
-        ExprKind::Binary(BinOp::Eq, l, r) => {
+        ExprKind::Binary(BinOp::Eq, operands) => {
+            let [l, r] = &**operands;
             let tested = if status_of_x(l) {
                 constant(r)
             } else if status_of_x(r) {

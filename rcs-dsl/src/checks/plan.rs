@@ -157,7 +157,8 @@ pub(crate) fn check_entry(p: &Plan, sink: &mut Sink) {
 fn has_false_conjunct(e: &Expr) -> bool {
     match &e.kind {
         ExprKind::Bool(false) => true,
-        ExprKind::Binary(crate::ast::BinOp::And, l, r) => {
+        ExprKind::Binary(crate::ast::BinOp::And, operands) => {
+            let [l, r] = &**operands;
             has_false_conjunct(l) || has_false_conjunct(r)
         }
         _ => false,

@@ -13,8 +13,8 @@ pub(crate) fn check_float_equality(c: &Controller, sink: &mut Sink) {
         for r in &p.rows {
             let mut found = Vec::new();
             r.visit_exprs(&mut |e| {
-                if let ExprKind::Binary(op @ (BinOp::Eq | BinOp::Ne), l, _) = &e.kind {
-                    if matches!(l.ty, Type::Float(_)) {
+                if let ExprKind::Binary(op @ (BinOp::Eq | BinOp::Ne), operands) = &e.kind {
+                    if matches!(operands[0].ty, Type::Float(_)) {
                         found.push((*op, e.span));
                     }
                 }

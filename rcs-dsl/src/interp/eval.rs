@@ -95,7 +95,10 @@ impl Interpreter<'_> {
                 let v = self.eval(x, hooks);
                 crate::arith::cast(v, &e.ty)
             }
-            ExprKind::Binary(op, l, r) => self.binary(*op, l, r, &e.ty, hooks),
+            ExprKind::Binary(op, operands) => {
+                let [l, r] = &**operands;
+                self.binary(*op, l, r, &e.ty, hooks)
+            }
             ExprKind::Builtin(b, args) => {
                 let values: Vec<Value> = args.iter().map(|a| self.eval(a, hooks)).collect();
                 let ty = args.first().map_or(&e.ty, |a| &a.ty);

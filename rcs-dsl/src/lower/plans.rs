@@ -23,7 +23,7 @@ impl Cx<'_, '_> {
         }];
         let mut names = ByName::default();
         names.first_or_insert("S0", 0);
-        let mut rows = Vec::new();
+        let mut rows = Vec::with_capacity(ast_rows.len());
         for (pos, r) in ast_rows.iter().enumerate() {
             if let Some(row) = self.row(r, pos as u32, (&mut states, &mut names)) {
                 rows.push(row);
@@ -105,7 +105,10 @@ impl Cx<'_, '_> {
             ast::Target::State(n) if n.text == "Done" => Target::Done,
             ast::Target::State(n) => Target::State(intern(states, n)),
         };
-        let jobs = r.jobs.iter().filter_map(|j| self.job(j)).collect();
+        // Sized once: `filter_map` gives no lower bound, and a vector grown
+        // from empty holds four jobs (700 bytes) for the usual one or two.
+        let mut jobs = Vec::with_capacity(r.jobs.len());
+        jobs.extend(r.jobs.iter().filter_map(|j| self.job(j)));
         Some(Row {
             position,
             label: r.label.map(|(n, _)| n.min(u32::MAX as u64) as u32),
@@ -485,7 +488,8 @@ impl Cx<'_, '_> {
 pub fn has_new_command_conjunct(e: &Expr) -> bool {
     match &e.kind {
         ExprKind::NewCommand => true,
-        ExprKind::Binary(BinOp::And, l, r) => {
+        ExprKind::Binary(BinOp::And, operands) => {
+            let [l, r] = &**operands;
             has_new_command_conjunct(l) || has_new_command_conjunct(r)
         }
         _ => false,

@@ -149,3 +149,64 @@ fn check_nesting(file: FileId, text: &str) -> Result<(), Vec<Diagnostic>> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The condition of the first row of the first plan, fully parenthesised.
+    fn condition(cond: &str) -> String {
+        let text = format!(
+            "controller A {{\n command GO\n plan GO {{\n *0 when {cond} -> Done\n }}\n}}\n"
+        );
+        let file = parse_file(FileId(0), &text).expect("parses");
+        let Item::Controller(c) = &file.items[0] else {
+            panic!("a controller")
+        };
+        let rows = c
+            .entries
+            .iter()
+            .find_map(|e| match &e.kind {
+                EntryKind::Plan(p) => Some(&p.rows),
+                _ => None,
+            })
+            .expect("a plan");
+        show(rows[0].cond.as_ref().expect("a condition"))
+    }
+
+    fn show(e: &Expr) -> String {
+        match &e.kind {
+            ExprKind::Path(None, n) => n.text.to_string(),
+            ExprKind::Int(n) => n.to_string(),
+            ExprKind::Unary(UnOp::Not, x) => format!("!{}", show(x)),
+            ExprKind::Unary(UnOp::Neg, x) => format!("-{}", show(x)),
+            ExprKind::Cast(x, ty) => format!("({} as {})", show(x), ty.text),
+            ExprKind::Binary(op, operands) => {
+                let [l, r] = &**operands;
+                format!("({} {} {})", show(l), op.symbol(), show(r))
+            }
+            ExprKind::Paren(x) => show(x),
+            other => format!("{other:?}"),
+        }
+    }
+
+    /// Prefixes, casts and operators arrive from pest as one flat list
+    /// (grammar.pest: `operand` is silent and casts share the operator
+    /// loop); the builder must still bind casts tightest, then prefixes,
+    /// then operators by precedence.
+    #[test]
+    fn prefixes_casts_and_operators_group_as_documented() {
+        assert_eq!(condition("-x as u8 > 1"), "(-(x as u8) > 1)");
+        assert_eq!(condition("!!a && - -b"), "(!!a && --b)");
+        assert_eq!(
+            condition("a as u8 as u16 + -b as u16 == c"),
+            "((((a as u8) as u16) + -(b as u16)) == c)"
+        );
+        assert_eq!(
+            condition("a + b * c as i64 - d"),
+            "((a + (b * (c as i64))) - d)"
+        );
+        assert_eq!(condition("!(a || b) && c"), "(!(a || b) && c)");
+        assert_eq!(condition("x - -y < 3 || z"), "(((x - -y) < 3) || z)");
+    }
+}

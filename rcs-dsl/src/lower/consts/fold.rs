@@ -179,7 +179,10 @@ impl Folder<'_, '_> {
                     }
                 }
             }
-            ast::ExprKind::Binary(op, l, r) => self.binary(scope, *op, l, r, hint, e.span),
+            ast::ExprKind::Binary(op, operands) => {
+                let [l, r] = &**operands;
+                self.binary(scope, *op, l, r, hint, e.span)
+            }
         }
     }
 

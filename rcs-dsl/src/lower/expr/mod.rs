@@ -159,7 +159,7 @@ impl Cx<'_, '_> {
     pub(in crate::lower) fn fix_literals(&mut self, e: &mut Expr, ty: &Type) {
         let literal = match &e.kind {
             ExprKind::Int(_) | ExprKind::Float(_) => true,
-            ExprKind::Unary(UnOp::Neg, _) | ExprKind::Binary(_, _, _) => e.ty != *ty,
+            ExprKind::Unary(UnOp::Neg, _) | ExprKind::Binary(..) => e.ty != *ty,
             _ => false,
         };
         if !literal {
@@ -195,7 +195,8 @@ impl Cx<'_, '_> {
                 );
             }
             (ExprKind::Unary(UnOp::Neg, inner), _) => self.fix_literals(inner, ty),
-            (ExprKind::Binary(op, l, r), _) if is_arith(*op) => {
+            (ExprKind::Binary(op, operands), _) if is_arith(*op) => {
+                let [l, r] = &mut **operands;
                 self.fix_literals(l, ty);
                 self.fix_literals(r, ty);
             }
@@ -338,7 +339,10 @@ impl Cx<'_, '_> {
                 (mk(kind, (*elem).clone()), Ty::Known(*elem))
             }
             ast::ExprKind::Unary(op, inner) => self.unary(*op, inner, span),
-            ast::ExprKind::Binary(op, l, r) => self.binary(*op, l, r, span),
+            ast::ExprKind::Binary(op, operands) => {
+                let [l, r] = &**operands;
+                self.binary(*op, l, r, span)
+            }
             ast::ExprKind::Cast(inner, ty) => {
                 let (mut x, t) = self.infer(inner, None);
                 let target = match primitive(&ty.text) {

@@ -91,7 +91,7 @@ impl Cx<'_, '_> {
                 let b = self.check(r, &Type::Bool);
                 (
                     Expr {
-                        kind: ExprKind::Binary(op, Box::new(a), Box::new(b)),
+                        kind: ExprKind::binary(op, a, b),
                         ty: Type::Bool,
                         span,
                     },
@@ -174,7 +174,7 @@ impl Cx<'_, '_> {
                     let ty = known(&t).unwrap_or(a.ty.clone());
                     (
                         Expr {
-                            kind: ExprKind::Binary(op, Box::new(a), Box::new(b)),
+                            kind: ExprKind::binary(op, a, b),
                             ty,
                             span,
                         },
@@ -191,7 +191,7 @@ impl Cx<'_, '_> {
                     }
                     (
                         Expr {
-                            kind: ExprKind::Binary(op, Box::new(a), Box::new(b)),
+                            kind: ExprKind::binary(op, a, b),
                             ty: Type::Bool,
                             span,
                         },

@@ -52,7 +52,7 @@ impl Builder {
             let d = dl.max(dr) + 1;
             operands.push((
                 Expr {
-                    kind: ExprKind::Binary(op, Box::new(l), Box::new(r)),
+                    kind: ExprKind::Binary(op, Box::new([l, r])),
                     span,
                 },
                 d,

@@ -40,7 +40,13 @@ impl Builder {
                     cond = Some(self.expr(c));
                 }
                 Rule::target => target = Some(self.target(c)),
-                Rule::jobs => jobs = c.into_inner().map(|j| self.job(j)).collect(),
+                Rule::jobs => {
+                    // Sized exactly: collecting from pest's pairs starts at
+                    // four jobs (640 bytes) for the usual one or two.
+                    let inner = c.into_inner();
+                    jobs = Vec::with_capacity(inner.len());
+                    jobs.extend(inner.map(|j| self.job(j)));
+                }
                 _ => {}
             }
         }

@@ -335,7 +335,7 @@ pub(super) fn lower_controller_body(
 pub(super) struct ControllerBody {
     /// Each var's initial value, by the var's index.
     inits: Vec<(usize, Expr)>,
-    plans: Vec<Plan>,
+    pub(super) plans: Vec<Plan>,
     /// Each command's plan, by the command's index.
     plan_of: Vec<Option<PlanId>>,
     /// The `pre` and `post` blocks.

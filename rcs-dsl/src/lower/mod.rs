@@ -151,21 +151,22 @@ pub fn lower(
     let rows: usize = ids.iter().map(|(_, c, _)| c.entries.len()).sum();
     let bodies = crate::parallel::map_ordered(&ids, rows >= 2048, |(id, c, rows)| {
         let rows = std::mem::take(&mut *rows.lock().unwrap_or_else(|e| e.into_inner()));
-        declarations::lower_controller_body(&globals, &names, &ir, *id, c, rows)
+        let mut body = declarations::lower_controller_body(&globals, &names, &ir, *id, c, rows);
+        // Each row's line, for generated comments: looked up here, on the
+        // worker, rather than for the whole set on one thread afterwards.
+        for row in body.plans.iter_mut().flat_map(|p| &mut p.rows) {
+            row.line = sources
+                .get(row.span.file)
+                .line_col(row.span.start as usize)
+                .0 as u32;
+        }
+        body
     });
     for ((id, _, _), mut body) in ids.iter().zip(bodies) {
         diags.extend(std::mem::take(&mut body.diags));
         body.apply(&mut ir.controllers[id.index()]);
     }
     ir.schedule = lower_schedule(&ir, manifest, diags);
-    for c in &mut ir.controllers {
-        for row in c.plans.iter_mut().flat_map(|p| &mut p.rows) {
-            row.line = sources
-                .get(row.span.file)
-                .line_col(row.span.start as usize)
-                .0 as u32;
-        }
-    }
     diags.sort_from(start, sources);
     if diags.has_errors() {
         None

@@ -151,7 +151,6 @@ fn rule_words(rule: Rule) -> Option<&'static str> {
         Rule::call_args => "`(`",
         Rule::infix => "an operator",
         Rule::op_unary => "an expression",
-        Rule::field_access => "`.`",
         Rule::index => "`[`",
         Rule::lint_level => "`allow`, `warn` or `deny`",
         Rule::kw_when => "`when`",

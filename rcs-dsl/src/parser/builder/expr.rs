@@ -158,14 +158,7 @@ impl Builder {
         let mut suffixes = inner.peekable();
         // `cmd.P`: the command parameter, not a field of something named `cmd`.
         if matches!(&e.kind, ExprKind::Path(None, n) if n.text == "cmd") {
-            let param = suffixes
-                .next_if(|s| {
-                    s.clone()
-                        .into_inner()
-                        .next()
-                        .is_some_and(|c| c.as_rule() == Rule::ident && !is_field_keyword(&c))
-                })
-                .map(|s| s.into_inner().next().expect("field name"));
+            let param = suffixes.next_if(|s| s.as_rule() == Rule::ident && !is_field_keyword(s));
             match param {
                 Some(p) => {
                     let span = e.span.to(self.span(&p));
@@ -186,10 +179,10 @@ impl Builder {
                 }
             }
         }
-        for s in suffixes {
-            let sspan = self.span(&s);
-            let span = e.span.to(sspan);
-            let c = s.into_inner().next().expect("suffix has one child");
+        // A field arrives as its name (`field_access` is silent), an index
+        // as an `index` pair.
+        for c in suffixes {
+            let span = e.span.to(self.span(&c));
             e = match c.as_rule() {
                 // `status` and `error` are keywords but valid after a dot.
                 Rule::ident if is_field_keyword(&c) => Expr {
@@ -207,6 +200,7 @@ impl Builder {
                     span,
                 },
                 _ => {
+                    let c = c.into_inner().next().expect("an index expression");
                     let idx = self.expr_at(c, depth + 1);
                     Expr {
                         kind: ExprKind::Index(Box::new(e), Box::new(idx)),

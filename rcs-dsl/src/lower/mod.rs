@@ -177,9 +177,12 @@ pub fn lower(
 
 /// Where each name of one scope was first declared, so that finding a name
 /// stays O(log n) however many a file declares (a hostile one may declare
-/// a million: a linear search per declaration would take hours).
+/// a million: a linear search per declaration would take hours). Names
+/// up to 24 bytes are kept inline, without an allocation each: a plan set
+/// makes one of these per plan (its states) and per command (its
+/// parameters).
 #[derive(Default)]
-pub(super) struct ByName(BTreeMap<String, usize>);
+pub(super) struct ByName(BTreeMap<compact_str::CompactString, usize>);
 
 impl ByName {
     /// The names of a finished scope, in declaration order (the first of
@@ -202,7 +205,7 @@ impl ByName {
         if let Some(&i) = self.0.get(name) {
             return Some(i);
         }
-        self.0.insert(name.to_string(), index);
+        self.0.insert(name.into(), index);
         None
     }
 

@@ -65,7 +65,9 @@ impl Builder {
         let mut parts = Operand::default();
         for c in p.into_inner() {
             match c.as_rule() {
-                Rule::op_unary => parts.prefixes.push((c.as_str() == "!", self.span(&c))),
+                Rule::op_unary => parts
+                    .prefixes
+                    .push((c.as_str() == "!", self.token_span(&c))),
                 Rule::postfix_expr => parts.base = Some(c),
                 Rule::ident => parts.casts.push(c),
                 Rule::infix => {
@@ -182,7 +184,7 @@ impl Builder {
         // A field arrives as its name (`field_access` is silent), an index
         // as an `index` pair.
         for c in suffixes {
-            let span = e.span.to(self.span(&c));
+            let span = e.span.to(self.token_span(&c));
             e = match c.as_rule() {
                 // `status` and `error` are keywords but valid after a dot.
                 Rule::ident if is_field_keyword(&c) => Expr {
@@ -190,7 +192,7 @@ impl Builder {
                         Box::new(e),
                         Name {
                             text: c.as_str().into(),
-                            span: self.span(&c),
+                            span: self.token_span(&c),
                         },
                     ),
                     span,
@@ -214,7 +216,8 @@ impl Builder {
     }
 
     pub(in crate::parser) fn primary(&mut self, p: Pair<Rule>, depth: usize) -> (Expr, usize) {
-        let span = self.span(&p);
+        // A number, a name or call, or a parenthesis: each ends in a token.
+        let span = self.token_span(&p);
         let mut height = 1;
         let kind = match p.as_rule() {
             Rule::number if p.as_str().contains(['.', 'e', 'E']) => {

@@ -31,11 +31,19 @@ impl Builder {
         Span::new(self.file, s.start(), s.end() - trailing)
     }
 
+    /// The span of a pair that cannot end in whitespace (a token, or a
+    /// rule that ends in one): [`Builder::span`] without the trimming.
+    pub(in crate::parser) fn token_span(&self, p: &Pair<Rule>) -> Span {
+        let s = p.as_span();
+        Span::new(self.file, s.start(), s.end())
+    }
+
     /// A user-chosen name; reserved words are refused here (see grammar.pest).
     pub(in crate::parser) fn name(&mut self, p: Pair<Rule>) -> Name {
+        // An identifier is a token: no trailing whitespace to trim.
         let name = Name {
             text: p.as_str().into(),
-            span: self.span(&p),
+            span: self.token_span(&p),
         };
         if RESERVED.contains(&name.text.as_str()) {
             let help = match name.text.as_str() {

@@ -177,6 +177,14 @@ mod tests {
     fn show(e: &Expr) -> String {
         match &e.kind {
             ExprKind::Path(None, n) => n.text.to_string(),
+            ExprKind::CmdParam(n) => format!("cmd.{}", n.text),
+            ExprKind::Path(Some(q), n) => format!("{}::{}", q.text, n.text),
+            ExprKind::Call(f, args) => {
+                let args: Vec<String> = args.iter().map(show).collect();
+                format!("{}({})", f.text, args.join(", "))
+            }
+            ExprKind::Field(x, n) => format!("{}.{}", show(x), n.text),
+            ExprKind::Index(x, i) => format!("{}[{}]", show(x), show(i)),
             ExprKind::Int(n) => n.to_string(),
             ExprKind::Unary(UnOp::Not, x) => format!("!{}", show(x)),
             ExprKind::Unary(UnOp::Neg, x) => format!("-{}", show(x)),
@@ -208,5 +216,12 @@ mod tests {
         );
         assert_eq!(condition("!(a || b) && c"), "(!(a || b) && c)");
         assert_eq!(condition("x - -y < 3 || z"), "(((x - -y) < 3) || z)");
+        // A name's arguments and `::VARIANT` belong to it; fields and
+        // indexes follow (`name_expr` and `field_access` are silent).
+        assert_eq!(
+            condition("f(a, b.c).d[i] as u8 > -g().h && m == Mode::Run"),
+            "(((f(a, b.c).d[i] as u8) > -g().h) && (m == Mode::Run))"
+        );
+        assert_eq!(condition("cmd.n + x.status.y"), "(cmd.n + x.status.y)");
     }
 }

@@ -145,9 +145,7 @@ fn rule_words(rule: Rule) -> Option<&'static str> {
         Rule::assign_op => "`=`, `+=` or `-=`",
         Rule::send_arrow => "`<-`",
         Rule::arrow => "`->`",
-        Rule::expr | Rule::operand | Rule::postfix_expr | Rule::paren | Rule::name_expr => {
-            "an expression"
-        }
+        Rule::expr | Rule::operand | Rule::postfix_expr | Rule::paren => "an expression",
         Rule::call_args => "`(`",
         Rule::infix => "an operator",
         Rule::op_unary => "an expression",

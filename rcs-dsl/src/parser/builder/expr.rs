@@ -149,6 +149,17 @@ impl Builder {
     pub(in crate::parser) fn postfix(&mut self, p: Pair<Rule>, depth: usize) -> (Expr, usize) {
         let mut inner = p.into_inner();
         let first = inner.next().expect("primary");
+        // A name's arguments or `::VARIANT` belong to the primary (the
+        // grammar's `name_expr` is silent), not to its suffixes.
+        let tail = match inner.peek() {
+            Some(t)
+                if first.as_rule() == Rule::ident
+                    && matches!(t.as_rule(), Rule::call_args | Rule::path_tail) =>
+            {
+                inner.next()
+            }
+            _ => None,
+        };
         // Counted on a copy of the iterator (cheap) rather than collected:
         // most operands have a suffix, and collecting allocated for each.
         let count = inner.clone().count();
@@ -156,7 +167,7 @@ impl Builder {
             let span = self.span(&first);
             return (self.too_deep(span), 1);
         }
-        let (mut e, mut h) = self.primary(first, depth + count);
+        let (mut e, mut h) = self.primary(first, tail, depth + count);
         let mut suffixes = inner.peekable();
         // `cmd.P`: the command parameter, not a field of something named `cmd`.
         if matches!(&e.kind, ExprKind::Path(None, n) if n.text == "cmd") {
@@ -215,9 +226,19 @@ impl Builder {
         (e, h)
     }
 
-    pub(in crate::parser) fn primary(&mut self, p: Pair<Rule>, depth: usize) -> (Expr, usize) {
-        // A number, a name or call, or a parenthesis: each ends in a token.
-        let span = self.token_span(&p);
+    /// A number, a parenthesis, or a name with its `tail` (call arguments
+    /// or `::VARIANT`).
+    pub(in crate::parser) fn primary(
+        &mut self,
+        p: Pair<Rule>,
+        tail: Option<Pair<Rule>>,
+        depth: usize,
+    ) -> (Expr, usize) {
+        // Each ends in a token: no whitespace to trim.
+        let span = match &tail {
+            Some(t) => self.token_span(&p).to(self.token_span(t)),
+            None => self.token_span(&p),
+        };
         let mut height = 1;
         let kind = match p.as_rule() {
             Rule::number if p.as_str().contains(['.', 'e', 'E']) => {
@@ -240,10 +261,9 @@ impl Builder {
                     ExprKind::Int(0)
                 }
             },
-            Rule::name_expr => {
-                let mut inner = p.into_inner();
-                let first = inner.next().expect("a name");
-                match (first.as_str(), inner.peek().map(|c| c.as_rule())) {
+            Rule::ident => {
+                let first = p;
+                match (first.as_str(), tail.as_ref().map(|c| c.as_rule())) {
                     ("true", None) => ExprKind::Bool(true),
                     ("false", None) => ExprKind::Bool(false),
                     ("new_command", None) => ExprKind::NewCommand,
@@ -259,8 +279,7 @@ impl Builder {
                     ),
                     (_, Some(Rule::call_args)) => {
                         let name = self.name(first);
-                        let args = inner
-                            .next()
+                        let args = tail
                             .expect("arguments")
                             .into_inner()
                             .map(|a| self.expr_at(a, depth + 1))
@@ -270,7 +289,8 @@ impl Builder {
                     }
                     (_, Some(_)) => {
                         let qualifier = self.name(first);
-                        let name = self.name(inner.next().expect("variant"));
+                        let variant = tail.expect("`::VARIANT`").into_inner().next();
+                        let name = self.name(variant.expect("variant"));
                         ExprKind::Path(Some(Box::new(qualifier)), name)
                     }
                     (_, None) => ExprKind::Path(None, self.name(first)),

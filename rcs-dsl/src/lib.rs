@@ -74,10 +74,10 @@ impl Checked {
 /// Check a loaded plan set: parse, lower, validate.
 pub fn check(set: &PlanSet, options: &Options) -> Checked {
     let mut diags = Diagnostics::new();
-    let Some(files) = parse(set, &mut diags) else {
+    let Some(parsed) = parse(set, &mut diags) else {
         return finish(None, diags);
     };
-    let Some(ir) = lower_files(set, files, &mut diags) else {
+    let Some(ir) = lower_files(set, parsed, &mut diags) else {
         return finish(None, diags);
     };
     let mut levels = LintLevels::default();
@@ -99,12 +99,19 @@ pub fn lower_unchecked(set: &PlanSet) -> Option<ir::Ir> {
 
 /// Stages 0–2: the load diagnostics, parsing and lowering.
 fn front(set: &PlanSet, diags: &mut Diagnostics) -> Option<ir::Ir> {
-    let files = parse(set, diags)?;
-    lower_files(set, files, diags)
+    let parsed = parse(set, diags)?;
+    lower_files(set, parsed, diags)
+}
+
+/// The parsed files, in path order, and the worker that parsed each (so
+/// that lowering frees each file's rows on the thread that built them).
+struct Parsed {
+    files: Vec<ast::File>,
+    parsed_on: std::collections::BTreeMap<source::FileId, parallel::Worker>,
 }
 
 /// Stages 0 and 1: the load diagnostics and parsing; `None` on an error.
-fn parse(set: &PlanSet, diags: &mut Diagnostics) -> Option<Vec<ast::File>> {
+fn parse(set: &PlanSet, diags: &mut Diagnostics) -> Option<Parsed> {
     // Stage 0 (load and manifest) and stage 1 (parse) are independent, so
     // their errors are reported together.
     let unreadable: Vec<source::FileId> = set
@@ -123,9 +130,13 @@ fn parse(set: &PlanSet, diags: &mut Diagnostics) -> Option<Vec<ast::File>> {
         .filter(|id| !unreadable.contains(id))
         .collect();
     let mut files = Vec::with_capacity(todo.len());
-    for result in parse_all(set, &todo) {
+    let mut parsed_on = std::collections::BTreeMap::new();
+    for (id, (result, worker)) in todo.iter().zip(parse_all(set, &todo)) {
         match result {
-            Ok(f) => files.push(f),
+            Ok(f) => {
+                files.push(f);
+                parsed_on.insert(*id, worker);
+            }
             Err(ds) => ds.into_iter().for_each(|d| diags.push(d)),
         }
     }
@@ -133,11 +144,11 @@ fn parse(set: &PlanSet, diags: &mut Diagnostics) -> Option<Vec<ast::File>> {
     if diags.has_errors() {
         return None;
     }
-    Some(files)
+    Some(Parsed { files, parsed_on })
 }
 
 /// Stage 2: lowering parsed files; `None` on an error.
-fn lower_files(set: &PlanSet, files: Vec<ast::File>, diags: &mut Diagnostics) -> Option<ir::Ir> {
+fn lower_files(set: &PlanSet, parsed: Parsed, diags: &mut Diagnostics) -> Option<ir::Ir> {
     let system = set
         .manifest
         .system
@@ -150,7 +161,8 @@ fn lower_files(set: &PlanSet, files: Vec<ast::File>, diags: &mut Diagnostics) ->
         .map(|(id, _)| set.relative_path(id))
         .collect();
     let ir = lower::lower(
-        files,
+        parsed.files,
+        &parsed.parsed_on,
         file_names,
         &set.manifest,
         &system,
@@ -160,7 +172,7 @@ fn lower_files(set: &PlanSet, files: Vec<ast::File>, diags: &mut Diagnostics) ->
     ir.filter(|_| !diags.has_errors())
 }
 
-type Parsed = Result<ast::File, Vec<Diagnostic>>;
+type ParseResult = Result<ast::File, Vec<Diagnostic>>;
 
 /// Below this much `.rcs` text a thread costs more than it saves.
 const PARALLEL_BYTES: usize = 256 * 1024;
@@ -174,8 +186,8 @@ fn rcs_bytes(set: &PlanSet) -> usize {
 
 /// Parse files, on both cores when there is enough text (files are
 /// independent), returning results in the order of `ids`.
-fn parse_all(set: &PlanSet, ids: &[source::FileId]) -> Vec<Parsed> {
-    parallel::map_ordered(ids, rcs_bytes(set) >= PARALLEL_BYTES, |id| {
+fn parse_all(set: &PlanSet, ids: &[source::FileId]) -> Vec<(ParseResult, parallel::Worker)> {
+    parallel::map_ordered_on(ids, rcs_bytes(set) >= PARALLEL_BYTES, |id| {
         parser::parse_file(*id, &set.sources.get(*id).text)
     })
 }

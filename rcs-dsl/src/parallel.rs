@@ -1,10 +1,15 @@
 //! The one way the pipeline uses both cores: an order-preserving parallel
-//! map. Parsing (per file), lowering (per controller body) and the analyses
-//! (per controller) each call [`map_ordered`]; the results come back in the
-//! order of the input, so every later stage — and every diagnostic — is the
-//! same whatever the threads did.
+//! map. Parsing (per file) and the analyses (per controller) call
+//! [`map_ordered`]; lowering (per controller body) calls [`map_pinned`], so
+//! that each body is lowered by the worker that parsed its file. The
+//! results come back in the order of the input, so every later stage — and
+//! every diagnostic — is the same whatever the threads did.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Which thread of a parallel map computed an item: 0 is the calling
+/// thread, 1… the threads it started.
+pub(crate) type Worker = usize;
 
 /// `items.iter().map(f).collect()`, on as many threads as the machine has
 /// when `worth_threads` says the work outweighs starting them. Workers take
@@ -17,33 +22,88 @@ where
     R: Send,
     F: Fn(&'a T) -> R + Sync,
 {
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(items.len());
-    if !worth_threads || threads < 2 {
-        return items.iter().map(f).collect();
-    }
+    map_ordered_on(items, worth_threads, f)
+        .into_iter()
+        .map(|(r, _)| r)
+        .collect()
+}
+
+/// [`map_ordered`], saying which worker computed each result.
+pub(crate) fn map_ordered_on<'a, T: Sync, R: Send, F: Fn(&'a T) -> R + Sync>(
+    items: &'a [T],
+    worth_threads: bool,
+    f: F,
+) -> Vec<(R, Worker)> {
+    let Some(threads) = threads_for(items.len(), worth_threads) else {
+        return items.iter().map(|t| (f(t), 0)).collect();
+    };
     let next = AtomicUsize::new(0);
-    let work = || {
+    run(items.len(), threads, |w| {
         let mut done = Vec::new();
         loop {
             let i = next.fetch_add(1, Ordering::Relaxed);
             let Some(item) = items.get(i) else {
                 return done;
             };
-            done.push((i, f(item)));
+            done.push((i, (f(item), w)));
         }
+    })
+}
+
+/// `items.iter().map(f).collect()` with item `i` computed by worker
+/// `workers[i]` (a [`Worker`] from [`map_ordered_on`]). Memory is cheapest
+/// to free on the thread that allocated it: glibc keeps an arena per
+/// thread, a thread that frees another arena's blocks takes that arena's
+/// lock against its owner, and a new thread takes over the arena of one
+/// that ended. So a stage that consumes what an earlier one built (the
+/// lowering of a controller frees its parsed rows) runs each item on the
+/// worker that built its input.
+pub(crate) fn map_pinned<'a, T: Sync, R: Send, F: Fn(&'a T) -> R + Sync>(
+    items: &'a [T],
+    workers: &[Worker],
+    worth_threads: bool,
+    f: F,
+) -> Vec<R> {
+    let Some(threads) = threads_for(items.len(), worth_threads) else {
+        return items.iter().map(f).collect();
     };
+    run(items.len(), threads, |w| {
+        items
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| workers.get(*i).copied().unwrap_or(0) % threads == w)
+            .map(|(i, item)| (i, f(item)))
+            .collect()
+    })
+}
+
+/// How many threads a map of `items` items uses; `None`: only the caller
+/// (the work is not `worth_threads`, or there is one core or one item).
+fn threads_for(items: usize, worth_threads: bool) -> Option<usize> {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(items);
+    (worth_threads && threads >= 2).then_some(threads)
+}
+
+/// Run `work` as workers `0..threads` (0 on the calling thread) and put
+/// the `(index, result)` pairs they return in index order.
+fn run<R, W>(len: usize, threads: usize, work: W) -> Vec<R>
+where
+    R: Send,
+    W: Fn(Worker) -> Vec<(usize, R)> + Sync,
+{
     let mut parts: Vec<Vec<(usize, R)>> = std::thread::scope(|scope| {
-        let helpers: Vec<_> = (1..threads).map(|_| scope.spawn(work)).collect();
-        let mut parts = vec![work()];
+        let work = &work;
+        let helpers: Vec<_> = (1..threads).map(|w| scope.spawn(move || work(w))).collect();
+        let mut parts = vec![work(0)];
         for h in helpers {
             parts.push(h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
         }
         parts
     });
     // Each worker's results are in increasing index order: merge them.
-    let mut slots: Vec<Option<R>> = (0..items.len()).map(|_| None).collect();
+    let mut slots: Vec<Option<R>> = (0..len).map(|_| None).collect();
     for part in &mut parts {
         for (i, r) in part.drain(..) {
             slots[i] = Some(r);
@@ -54,7 +114,48 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::map_ordered;
+    use super::{map_ordered, map_ordered_on, map_pinned, threads_for, Worker};
+    use std::thread::{current, ThreadId};
+
+    #[test]
+    fn pinned_items_run_on_their_worker_and_come_back_in_order() {
+        let items: Vec<u64> = (0..500).collect();
+        // More worker numbers than threads: they wrap around.
+        let workers: Vec<Worker> = items.iter().map(|x| (x % 3) as usize).collect();
+        let f = |&x: &u64| (x * 3 + 1, current().id());
+        let caller = current().id();
+        let threads = threads_for(items.len(), true).unwrap_or(1);
+        let out = map_pinned(&items, &workers, true, f);
+        let values: Vec<u64> = out.iter().map(|(v, _)| *v).collect();
+        assert_eq!(values, items.iter().map(|x| x * 3 + 1).collect::<Vec<_>>());
+        // Items of one worker ran on one thread, worker 0's on the caller.
+        let mut thread_of: Vec<Option<ThreadId>> = vec![None; threads];
+        for (w, (_, t)) in workers.iter().zip(&out) {
+            let slot = &mut thread_of[w % threads];
+            assert_eq!(*slot.get_or_insert(*t), *t);
+        }
+        assert_eq!(thread_of[0], Some(caller));
+        let serial: Vec<u64> = map_pinned(&items, &workers, false, f)
+            .into_iter()
+            .map(|(v, t)| {
+                assert_eq!(t, caller);
+                v
+            })
+            .collect();
+        assert_eq!(serial, values);
+    }
+
+    #[test]
+    fn workers_are_reported_as_they_ran() {
+        let items: Vec<u64> = (0..300).collect();
+        let caller = current().id();
+        let out = map_ordered_on(&items, true, |&x| (x, current().id()));
+        for (i, ((x, t), w)) in out.iter().enumerate() {
+            assert_eq!(*x, i as u64);
+            assert!(*w < threads_for(items.len(), true).unwrap_or(1));
+            assert_eq!(*w == 0, *t == caller);
+        }
+    }
 
     #[test]
     fn results_come_back_in_input_order_with_or_without_threads() {

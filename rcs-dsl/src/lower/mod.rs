@@ -111,6 +111,7 @@ fn take_plan_rows(files: &mut [ast::File]) -> BTreeMap<Span, Vec<Vec<ast::Row>>>
 /// Lower parsed files (already in path order) to the IR.
 pub fn lower(
     mut files: Vec<ast::File>,
+    parsed_on: &BTreeMap<crate::source::FileId, crate::parallel::Worker>,
     file_names: Vec<String>,
     manifest: &Manifest,
     system: &str,
@@ -149,7 +150,15 @@ pub fn lower(
         })
         .collect();
     let rows: usize = ids.iter().map(|(_, c, _)| c.entries.len()).sum();
-    let bodies = crate::parallel::map_ordered(&ids, rows >= 2048, |(id, c, rows)| {
+    // Each body on the worker that parsed its file: lowering frees the
+    // rows as it goes (see `take_plan_rows`), and freeing them on the
+    // thread that allocated them is what the allocator does best (see
+    // `parallel::map_pinned`).
+    let workers: Vec<crate::parallel::Worker> = ids
+        .iter()
+        .map(|(_, c, _)| parsed_on.get(&c.span.file).copied().unwrap_or(0))
+        .collect();
+    let bodies = crate::parallel::map_pinned(&ids, &workers, rows >= 2048, |(id, c, rows)| {
         let rows = std::mem::take(&mut *rows.lock().unwrap_or_else(|e| e.into_inner()));
         let mut body = declarations::lower_controller_body(&globals, &names, &ir, *id, c, rows);
         // Each row's line, for generated comments: looked up here, on the

@@ -57,7 +57,10 @@ pub(crate) fn map_ordered_on<'a, T: Sync, R: Send, F: Fn(&'a T) -> R + Sync>(
 /// lock against its owner, and a new thread takes over the arena of one
 /// that ended. So a stage that consumes what an earlier one built (the
 /// lowering of a controller frees its parsed rows) runs each item on the
-/// worker that built its input.
+/// worker that built its input. When that would leave a worker with more
+/// than its share and a quarter (one file holding most controllers), the
+/// items are shared out as [`map_ordered`] does instead: both cores are
+/// worth more than the allocator's preference.
 pub(crate) fn map_pinned<'a, T: Sync, R: Send, F: Fn(&'a T) -> R + Sync>(
     items: &'a [T],
     workers: &[Worker],
@@ -67,11 +70,18 @@ pub(crate) fn map_pinned<'a, T: Sync, R: Send, F: Fn(&'a T) -> R + Sync>(
     let Some(threads) = threads_for(items.len(), worth_threads) else {
         return items.iter().map(f).collect();
     };
+    let worker = |i: usize| workers.get(i).copied().unwrap_or(0) % threads;
+    let mut share = vec![0usize; threads];
+    (0..items.len()).for_each(|i| share[worker(i)] += 1);
+    let most = share.iter().copied().max().unwrap_or(0);
+    if most * threads * 4 > items.len() * 5 {
+        return map_ordered(items, worth_threads, f);
+    }
     run(items.len(), threads, |w| {
         items
             .iter()
             .enumerate()
-            .filter(|(i, _)| workers.get(*i).copied().unwrap_or(0) % threads == w)
+            .filter(|(i, _)| worker(*i) == w)
             .map(|(i, item)| (i, f(item)))
             .collect()
     })
@@ -120,11 +130,11 @@ mod tests {
     #[test]
     fn pinned_items_run_on_their_worker_and_come_back_in_order() {
         let items: Vec<u64> = (0..500).collect();
-        // More worker numbers than threads: they wrap around.
-        let workers: Vec<Worker> = items.iter().map(|x| (x % 3) as usize).collect();
+        let threads = threads_for(items.len(), true).unwrap_or(1);
+        // More worker numbers than threads (they wrap around), evenly.
+        let workers: Vec<Worker> = (0..items.len()).map(|i| i % (2 * threads)).collect();
         let f = |&x: &u64| (x * 3 + 1, current().id());
         let caller = current().id();
-        let threads = threads_for(items.len(), true).unwrap_or(1);
         let out = map_pinned(&items, &workers, true, f);
         let values: Vec<u64> = out.iter().map(|(v, _)| *v).collect();
         assert_eq!(values, items.iter().map(|x| x * 3 + 1).collect::<Vec<_>>());
@@ -143,6 +153,16 @@ mod tests {
             })
             .collect();
         assert_eq!(serial, values);
+    }
+
+    #[test]
+    fn uneven_pins_are_shared_out_instead() {
+        // Nearly everything pinned to worker 0 (one big file): the items
+        // are shared out, and still come back in order.
+        let items: Vec<u64> = (0..400).collect();
+        let workers: Vec<Worker> = items.iter().map(|x| usize::from(*x == 0)).collect();
+        let out = map_pinned(&items, &workers, true, |&x| x + 1);
+        assert_eq!(out, items.iter().map(|x| x + 1).collect::<Vec<_>>());
     }
 
     #[test]

@@ -16,16 +16,12 @@ pub(crate) type Worker = usize;
 /// the next item from a shared counter (items differ in size: a file of ten
 /// controllers beside a types file), and the results are put back in input
 /// order. A panic in `f` is resumed on the calling thread.
-pub(crate) fn map_ordered<'a, T, R, F>(items: &'a [T], worth_threads: bool, f: F) -> Vec<R>
-where
-    T: Sync,
-    R: Send,
-    F: Fn(&'a T) -> R + Sync,
-{
-    map_ordered_on(items, worth_threads, f)
-        .into_iter()
-        .map(|(r, _)| r)
-        .collect()
+pub(crate) fn map_ordered<'a, T: Sync, R: Send, F: Fn(&'a T) -> R + Sync>(
+    items: &'a [T],
+    worth_threads: bool,
+    f: F,
+) -> Vec<R> {
+    shared_out(items, worth_threads, |item, _| f(item))
 }
 
 /// [`map_ordered`], saying which worker computed each result.
@@ -34,8 +30,18 @@ pub(crate) fn map_ordered_on<'a, T: Sync, R: Send, F: Fn(&'a T) -> R + Sync>(
     worth_threads: bool,
     f: F,
 ) -> Vec<(R, Worker)> {
+    shared_out(items, worth_threads, |item, w| (f(item), w))
+}
+
+/// Both of the above: `f` is given each item and the worker computing it,
+/// workers taking the next item from a shared counter.
+fn shared_out<'a, T: Sync, R: Send, F: Fn(&'a T, Worker) -> R + Sync>(
+    items: &'a [T],
+    worth_threads: bool,
+    f: F,
+) -> Vec<R> {
     let Some(threads) = threads_for(items.len(), worth_threads) else {
-        return items.iter().map(|t| (f(t), 0)).collect();
+        return items.iter().map(|t| f(t, 0)).collect();
     };
     let next = AtomicUsize::new(0);
     run(items.len(), threads, |w| {
@@ -45,7 +51,7 @@ pub(crate) fn map_ordered_on<'a, T: Sync, R: Send, F: Fn(&'a T) -> R + Sync>(
             let Some(item) = items.get(i) else {
                 return done;
             };
-            done.push((i, (f(item), w)));
+            done.push((i, f(item, w)));
         }
     })
 }

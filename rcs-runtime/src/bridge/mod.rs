@@ -34,203 +34,34 @@
 //! lock-free, allocation-free seqlock copies; decoding, encoding and Zenoh
 //! itself run on the bridge's and Zenoh's threads.
 
+mod config;
+mod error;
+mod export;
+mod import;
 mod wire;
 
 #[cfg(test)]
 mod tests;
 
-use std::collections::BTreeMap;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use serde::de::DeserializeOwned;
 use serde::Serialize;
-use zenoh::pubsub::{Publisher, Subscriber};
+use zenoh::pubsub::Subscriber;
 use zenoh::qos::CongestionControl;
 use zenoh::{Session, Wait};
 
-use crate::gm::{BufferData, GlobalMemory, Reader, Writer};
+use crate::gm::{BufferData, GlobalMemory};
 use crate::schema::Schema;
-use crate::SetupError;
 
-/// How a process joins the others: its names and Zenoh endpoints.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct BridgeConfig {
-    /// The system (the manifest's `system:`): the second part of every key.
-    pub system: String,
-    /// This process's name (the manifest's `process:`), for thread names
-    /// and messages.
-    pub process: String,
-    /// Zenoh endpoints to listen on, e.g. `tcp/127.0.0.1:7447`.
-    pub listen: Vec<String>,
-    /// Zenoh endpoints of other processes to connect to (retried in the
-    /// background until they answer).
-    pub connect: Vec<String>,
-    /// Find peers by UDP multicast scouting as well (off: explicit
-    /// endpoints only, which is what tests and most plants want).
-    pub multicast_scouting: bool,
-    /// How often the bridge thread looks for new writes of exported
-    /// buffers. `None`: the generated `System::process` puts the period of
-    /// the fastest CPU in another process that reads one; a bridge started
-    /// with `None` polls every 1 ms.
-    pub poll_period: Option<Duration>,
-    /// How often every exported buffer is published again even if
-    /// unchanged, for processes that join late or restart.
-    pub resend_period: Duration,
-}
-
-impl BridgeConfig {
-    /// A configuration for process `process` of system `system`, with no
-    /// endpoints, multicast scouting off, the default polling and a 100 ms
-    /// resend.
-    pub fn new(system: &str, process: &str) -> Self {
-        Self {
-            system: system.to_owned(),
-            process: process.to_owned(),
-            listen: Vec::new(),
-            connect: Vec::new(),
-            multicast_scouting: false,
-            poll_period: None,
-            resend_period: Duration::from_millis(100),
-        }
-    }
-
-    /// Add an endpoint to listen on.
-    pub fn listen(mut self, endpoint: &str) -> Self {
-        self.listen.push(endpoint.to_owned());
-        self
-    }
-
-    /// Add an endpoint to connect to.
-    pub fn connect(mut self, endpoint: &str) -> Self {
-        self.connect.push(endpoint.to_owned());
-        self
-    }
-
-    /// The key expression of buffer `buffer`: `rcs/<system>/<buffer>`.
-    pub fn key(&self, buffer: &str) -> String {
-        format!("rcs/{}/{}", self.system, buffer)
-    }
-
-    fn zenoh_config(&self) -> Result<zenoh::Config, BridgeError> {
-        let list = |v: &[String]| -> Result<String, BridgeError> {
-            serde_json::to_string(v).map_err(|e| BridgeError::Zenoh(e.to_string()))
-        };
-        let mut c = zenoh::Config::default();
-        let mut set = |key: &str, value: String| {
-            c.insert_json5(key, &value)
-                .map_err(|e| BridgeError::Zenoh(format!("config `{key}`: {e}")))
-        };
-        set("mode", "\"peer\"".into())?;
-        set("listen/endpoints", list(&self.listen)?)?;
-        set("connect/endpoints", list(&self.connect)?)?;
-        set(
-            "scouting/multicast/enabled",
-            self.multicast_scouting.to_string(),
-        )?;
-        Ok(c)
-    }
-}
-
-/// What can go wrong in a bridge: at setup (returned), or with a received
-/// sample (recorded, see [`Bridge::errors`]).
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-pub enum BridgeError {
-    /// A sample of `buffer` carried another type's schema hash: the two
-    /// processes were built from different declarations. Not written.
-    #[error("buffer `{buffer}`: refused a sample of schema {got:#018x}, this process's type has schema {expected:#018x} (were both processes built from the same plan set?)")]
-    SchemaMismatch {
-        /// The buffer's name.
-        buffer: String,
-        /// The local type's schema hash.
-        expected: u64,
-        /// The hash the sample carried.
-        got: u64,
-    },
-    /// A sample of `buffer` could not be decoded. Not written.
-    #[error("buffer `{buffer}`: refused an undecodable sample ({message})")]
-    Decode {
-        /// The buffer's name.
-        buffer: String,
-        /// What postcard said.
-        message: String,
-    },
-    /// `System::process` was asked for a process the manifest does not name.
-    #[error("no process `{name}` in this plan set; its processes are: {}", known.join(", "))]
-    UnknownProcess {
-        /// The name asked for.
-        name: String,
-        /// The manifest's processes.
-        known: Vec<String>,
-    },
-    /// Zenoh refused the configuration or a declaration.
-    #[error("zenoh: {0}")]
-    Zenoh(String),
-    /// A buffer to bridge is unknown, of another type, or already written.
-    #[error(transparent)]
-    Setup(#[from] SetupError),
-}
-
-/// The errors received samples caused, the latest per buffer, and how many
-/// samples were refused in all. Written by Zenoh's threads, read by the
-/// application: a lock is fine here, it is not the cycle path.
-#[derive(Default)]
-struct ErrorLog {
-    latest: Mutex<BTreeMap<String, BridgeError>>,
-    refused: AtomicU64,
-}
-
-impl ErrorLog {
-    fn record(&self, buffer: &str, e: BridgeError) {
-        self.refused.fetch_add(1, Ordering::Relaxed);
-        let mut map = self.latest.lock().unwrap_or_else(|p| p.into_inner());
-        map.insert(buffer.to_owned(), e);
-    }
-}
-
-/// Counters of a running bridge.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct BridgeStats {
-    /// Samples published (exports, resends included).
-    pub published: u64,
-    /// Samples written into local cells (imports).
-    pub imported: u64,
-    /// Samples refused (schema mismatch or undecodable).
-    pub refused: u64,
-}
-
-#[derive(Default)]
-struct Counters {
-    published: AtomicU64,
-    imported: AtomicU64,
-}
-
-/// One exported buffer: its reader and the generation last published.
-trait Export: Send {
-    /// Encode the buffer into `out` if it changed since the last call (or
-    /// `resend` and it was ever written); false if there is nothing to send.
-    fn poll(&mut self, out: &mut Vec<u8>, resend: bool) -> bool;
-}
-
-struct ExportSlot<T> {
-    reader: Reader<T>,
-    last: u64,
-}
-
-impl<T: BufferData + Schema + Serialize> Export for ExportSlot<T> {
-    fn poll(&mut self, out: &mut Vec<u8>, resend: bool) -> bool {
-        let generation = self.reader.generation();
-        if generation == 0 || (generation == self.last && !resend) {
-            return false;
-        }
-        let s = self.reader.read();
-        self.last = s.generation;
-        out.clear();
-        wire::encode(out, T::SCHEMA, &s).is_ok()
-    }
-}
+pub use config::BridgeConfig;
+pub use error::{BridgeError, BridgeStats};
+use error::{Counters, ErrorLog};
+use export::{export_loop, Export, ExportSlot};
+use import::Import;
 
 /// An import waiting for [`BridgeBuilder::start`] to declare its subscriber.
 type Declare = Box<dyn FnOnce(&Session, &Shared) -> Result<Subscriber<()>, BridgeError>>;
@@ -238,8 +69,8 @@ type Declare = Box<dyn FnOnce(&Session, &Shared) -> Result<Subscriber<()>, Bridg
 /// What the subscriber callbacks share with the [`Bridge`].
 #[derive(Clone)]
 struct Shared {
-    errors: Arc<ErrorLog>,
-    counters: Arc<Counters>,
+    pub(super) errors: Arc<ErrorLog>,
+    pub(super) counters: Arc<Counters>,
 }
 
 /// Collects the buffers to export and import, then starts the [`Bridge`].
@@ -342,72 +173,6 @@ impl<'a> BridgeBuilder<'a> {
             exporter: Some(exporter),
             shared,
         })
-    }
-}
-
-/// The export thread: poll, publish what changed, sleep.
-fn export_loop(
-    mut exports: Vec<(Publisher<'static>, Box<dyn Export>)>,
-    stop: &AtomicBool,
-    counters: &Counters,
-    poll: Duration,
-    resend_every: Duration,
-) {
-    let mut out = Vec::with_capacity(256);
-    let mut last_resend = Instant::now();
-    while !stop.load(Ordering::Relaxed) {
-        let resend = last_resend.elapsed() >= resend_every;
-        if resend {
-            last_resend = Instant::now();
-        }
-        for (publisher, slot) in &mut exports {
-            if slot.poll(&mut out, resend) && publisher.put(out.as_slice()).wait().is_ok() {
-                counters.published.fetch_add(1, Ordering::Relaxed);
-            }
-        }
-        std::thread::sleep(poll);
-    }
-}
-
-/// The import side of one buffer, owned by its subscriber's callback.
-struct Import<T> {
-    writer: Writer<T>,
-    /// `(generation, writer_cycle)` of the last sample written.
-    last: Option<(u64, u64)>,
-    shared: Shared,
-}
-
-impl<T: BufferData + Schema + DeserializeOwned> Import<T> {
-    fn receive(&mut self, bytes: &[u8]) {
-        match wire::decode::<T>(bytes, T::SCHEMA) {
-            Ok(s) => {
-                if self.last == Some((s.generation, s.writer_cycle)) {
-                    return; // a resend of what the cell already holds
-                }
-                self.last = Some((s.generation, s.writer_cycle));
-                self.writer
-                    .write_stamped(s.value, s.generation, s.writer_cycle);
-                self.shared
-                    .counters
-                    .imported
-                    .fetch_add(1, Ordering::Relaxed);
-            }
-            Err(e) => {
-                let buffer = self.writer.name().to_owned();
-                let e = match e {
-                    wire::WireError::Schema(got) => BridgeError::SchemaMismatch {
-                        buffer: buffer.clone(),
-                        expected: T::SCHEMA,
-                        got,
-                    },
-                    wire::WireError::Decode(message) => BridgeError::Decode {
-                        buffer: buffer.clone(),
-                        message,
-                    },
-                };
-                self.shared.errors.record(&buffer, e);
-            }
-        }
     }
 }
 

@@ -50,6 +50,9 @@ pub(crate) enum Command {
     /// Sum up runtime traces: row hits and cycles per state, as text.
     #[command(after_help = crate::trace_cmd::TRACE_HELP)]
     Trace(crate::trace_cmd::TraceArgs),
+    /// Make a development CA and per-process certificates for a distributed plan set.
+    #[command(after_help = crate::certs_cmd::CERTS_HELP)]
+    Certs(crate::certs_cmd::CertsArgs),
 }
 
 const DIFF_HELP: &str = "\

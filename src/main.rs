@@ -7,6 +7,7 @@ use clap::Parser;
 use std::process::ExitCode;
 
 mod args;
+mod certs_cmd;
 mod commands;
 mod compiled;
 mod diff_cmd;
@@ -31,6 +32,7 @@ fn main() -> ExitCode {
         Command::Diff(args) => diff_cmd::diff(args),
         Command::Doc(args) => doc_cmd::doc(args),
         Command::Trace(args) => trace_cmd::trace(args),
+        Command::Certs(args) => certs_cmd::certs(args),
     }
 }
 

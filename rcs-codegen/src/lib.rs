@@ -7,6 +7,8 @@
 //! Ir ──rust──▶ rust/<system>.rs
 //!    ──dot───▶ graphs/<CTRL>/<VERB>.dot, graphs/hierarchy.dot
 //!    ──table─▶ tables/<CTRL>.md
+//!    ──acl───▶ zenoh/<PROCESS>.json5   (a distributed set: each process's
+//!                                        Zenoh configuration and policy)
 //! ```
 //!
 //! [`diff`] renders a semantic diff of two plan-set versions
@@ -18,6 +20,7 @@
 //! journal, and never writes through a link leading out of the folder or
 //! over a file rcsc did not generate (see its docs for what it promises).
 
+pub mod acl;
 pub mod config;
 pub mod diff;
 pub mod dot;
@@ -91,6 +94,15 @@ pub fn generate_with(ir: &Ir, options: &Options) -> Vec<OutputFile> {
             files.push(OutputFile {
                 path: format!("graphs/{}/{}.dot", ctrl.name, cmd.name),
                 contents: dot::plan_graph(ir, ctrl, &ctrl.plans[pid.index()]),
+            });
+        }
+    }
+    let placement = rcs_dsl::placement::Placement::of(ir);
+    if placement.is_distributed() {
+        for (p, process) in placement.processes.iter().enumerate() {
+            files.push(OutputFile {
+                path: format!("zenoh/{process}.json5"),
+                contents: acl::zenoh_config_file(ir, &placement, p),
             });
         }
     }

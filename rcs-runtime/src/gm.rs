@@ -237,20 +237,6 @@ impl<T: BufferData> Writer<T> {
         unsafe { self.cell.write((value, cycle)) }
     }
 
-    /// Publish `value` with the stamps of a write made in another process
-    /// (the Zenoh bridge's import side holds this buffer's only writer).
-    /// The generation stored is `generation`, or the current one plus one if
-    /// that is not above it (the remote writer restarted): generations never
-    /// go back, so a reader's `stale_cycles` sees the restarted writer's
-    /// first write as news. Returns the generation stored.
-    #[cfg(feature = "zenoh")]
-    #[inline]
-    pub(crate) fn write_stamped(&mut self, value: T, generation: u64, cycle: u64) -> u64 {
-        // SAFETY: as in `write`: this is the cell's only writer and `&mut
-        // self` excludes overlapping calls.
-        unsafe { self.cell.write_at((value, cycle), generation) }
-    }
-
     /// Read back the buffer (the writer's own last value and stamps).
     #[inline]
     pub fn read(&self) -> Stamped<T> {
@@ -356,37 +342,6 @@ mod tests {
         assert_eq!((s.value, s.generation, s.writer_cycle), (v, 2, 42));
         assert_eq!(w.read(), s);
         assert_eq!(r.name(), "ship");
-    }
-
-    #[cfg(feature = "zenoh")]
-    #[test]
-    fn stamped_writes_keep_remote_stamps_and_never_go_back() {
-        let gm = GlobalMemory::new();
-        gm.declare::<u32>("x").unwrap();
-        let mut w = gm.writer::<u32>("x").unwrap();
-        let r = gm.reader::<u32>("x").unwrap();
-        assert_eq!(w.write_stamped(5, 40, 7), 40);
-        assert_eq!(
-            r.read(),
-            Stamped {
-                value: 5,
-                generation: 40,
-                writer_cycle: 7
-            }
-        );
-        // The remote writer restarted: its generation 1 becomes 41 here.
-        assert_eq!(w.write_stamped(6, 1, 1), 41);
-        assert_eq!(
-            r.read(),
-            Stamped {
-                value: 6,
-                generation: 41,
-                writer_cycle: 1
-            }
-        );
-        assert_eq!(w.write_stamped(7, 41, 2), 42);
-        // And a plain write continues from there.
-        assert_eq!(w.write(8, 3), 43);
     }
 
     #[test]

@@ -97,6 +97,12 @@ impl ErrorCode {
     pub const fn is_none(self) -> bool {
         self.0 == 0
     }
+
+    /// Whether this is one of the runtime's built-in error codes (which
+    /// any controller can end with, whatever it declares).
+    pub const fn is_builtin(self) -> bool {
+        self.0 == Self::UNKNOWN_COMMAND.0 || self.0 == Self::INDEX_RANGE.0
+    }
 }
 
 /// The payload of a command buffer: a generated command enum (verb and
@@ -146,6 +152,39 @@ pub struct StatusBuffer {
     pub verb: VerbId,
     /// The current state of its plan.
     pub state: StateId,
+}
+
+impl StatusBuffer {
+    /// Whether every field is one a controller with `statuses` custom
+    /// statuses, `errors` declared error codes, `verbs` verbs and plans of
+    /// at most `states` states can write: `Err` names the field that is
+    /// not. The bridge refuses an imported status that fails this (a forged
+    /// or corrupt sample), so a supervisor never sees a status that does
+    /// not exist.
+    pub fn check_range(
+        &self,
+        statuses: u16,
+        errors: u16,
+        verbs: u16,
+        states: u16,
+    ) -> Result<(), &'static str> {
+        if self.status.0 >= Status::FIRST_CUSTOM.saturating_add(statuses) {
+            return Err("status");
+        }
+        let e = self.error;
+        let declared =
+            e.0 >= ErrorCode::FIRST_CUSTOM && e.0 < ErrorCode::FIRST_CUSTOM.saturating_add(errors);
+        if !(e.is_none() || e.is_builtin() || declared) {
+            return Err("error code");
+        }
+        if self.verb >= verbs.max(1) {
+            return Err("verb");
+        }
+        if self.state >= states.max(1) {
+            return Err("state");
+        }
+        Ok(())
+    }
 }
 
 /// The serial after `serial`: one more, wrapping from `u32::MAX` to 1, never 0.
@@ -489,6 +528,36 @@ mod tests {
         let mut mute = SubordinateLink::new();
         assert_eq!(mute.observe(&Stamped::default()).stale_cycles, 1);
         assert_eq!(mute.observe(&Stamped::default()).stale_cycles, 2);
+    }
+
+    #[test]
+    fn status_ranges() {
+        let ok = StatusBuffer {
+            echo_serial: 9,
+            status: Status::custom(1),
+            error: ErrorCode::custom(2),
+            verb: 1,
+            state: 4,
+        };
+        assert_eq!(ok.check_range(2, 3, 2, 5), Ok(()));
+        let bad = |f: fn(&mut StatusBuffer)| {
+            let mut s = ok;
+            f(&mut s);
+            s.check_range(2, 3, 2, 5)
+        };
+        assert_eq!(bad(|s| s.status = Status(u16::MAX)), Err("status"));
+        assert_eq!(bad(|s| s.status = Status::custom(2)), Err("status"));
+        assert_eq!(
+            bad(|s| s.error = ErrorCode(u16::MAX - 7)),
+            Err("error code")
+        );
+        assert_eq!(bad(|s| s.error = ErrorCode::custom(3)), Err("error code"));
+        assert_eq!(bad(|s| s.error = ErrorCode::INDEX_RANGE), Ok(()));
+        assert_eq!(bad(|s| s.error = ErrorCode::UNKNOWN_COMMAND), Ok(()));
+        assert_eq!(bad(|s| s.verb = 2), Err("verb"));
+        assert_eq!(bad(|s| s.state = 5), Err("state"));
+        // The zeroed buffer of a controller that has no verbs yet.
+        assert_eq!(StatusBuffer::default().check_range(0, 0, 0, 0), Ok(()));
     }
 
     #[test]

@@ -19,6 +19,7 @@
 //! | [`trace`] | optional JSON-lines trace of every controller's cycle |
 //! | [`schema`] | [`Schema`]: a stable hash of a buffer type's structure |
 //! | `bridge` | (feature `zenoh`) Global Memory across processes over Zenoh |
+//! | `acl` | (features `zenoh`, `certs`) identities for the bridge: mutual TLS, the opt-out, development certificates |
 //! | `seqlock` | the only `unsafe` code: the sequence lock behind Global Memory |
 //!
 //! ## Costs
@@ -180,6 +181,8 @@
 
 #![warn(missing_docs)]
 
+#[cfg(any(feature = "zenoh", feature = "certs"))]
+pub mod acl;
 #[cfg(feature = "zenoh")]
 pub mod bridge;
 pub mod driver;
@@ -195,6 +198,8 @@ pub mod schema;
 mod seqlock;
 pub mod trace;
 
+#[cfg(any(feature = "zenoh", feature = "certs"))]
+pub use acl::{Security, TlsFiles};
 #[cfg(feature = "zenoh")]
 pub use bridge::{Bridge, BridgeConfig, BridgeError};
 pub use error::SetupError;

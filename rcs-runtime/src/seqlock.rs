@@ -198,35 +198,6 @@ impl<T: Copy> SeqLock<T> {
         next / 2
     }
 
-    /// Store `value` as the write of generation `generation` (a writer in
-    /// another process numbered it), and return the generation stored.
-    ///
-    /// The counter must only ever grow, or a reader could see the same even
-    /// counter before and after a write and take a torn copy for a whole
-    /// one. So a `generation` not above the current one (the remote writer
-    /// restarted and counts from 1 again) is stored as the current
-    /// generation plus one instead.
-    ///
-    /// # Safety
-    ///
-    /// No other call of `write` or `write_at` on this cell may run at the
-    /// same time.
-    #[cfg(feature = "zenoh")]
-    #[inline]
-    pub(crate) unsafe fn write_at(&self, value: T, generation: u64) -> u64 {
-        let s = self.seq.load(Ordering::Relaxed);
-        let target = generation.max((s / 2).wrapping_add(1));
-        // `target > s / 2`, so the odd marker is above `s` and the final even
-        // value above the marker: the counter grows.
-        let final_seq = target.wrapping_mul(2);
-        self.seq.store(final_seq.wrapping_sub(1), Ordering::Relaxed);
-        fence(Ordering::Release);
-        // SAFETY: as in `write`.
-        unsafe { store_words(self.data.get(), value) };
-        self.seq.store(final_seq, Ordering::Release);
-        target
-    }
-
     /// One attempt at a consistent copy: `None` if a write overlapped.
     #[inline]
     pub(crate) fn try_read(&self) -> Option<(T, u64)> {

@@ -161,12 +161,21 @@ fn cycles_allocate_nothing_with_the_bridge_running() {
     engine
         .add(Box::new(Relay::new(&gm_b, "TB", None, 3).unwrap()))
         .unwrap();
-    let mut a = Bridge::builder(BridgeConfig::new("noalloc", "helm").listen(&ep), &gm_a);
+    let mut a = Bridge::builder(
+        BridgeConfig::new("noalloc", "helm").listen(&ep).insecure(),
+        &gm_a,
+    );
     a.export::<CommandBuffer<VerbId>>("TB.command").unwrap();
-    a.import::<StatusBuffer>("TB.status").unwrap();
+    a.import::<StatusBuffer>("TB.status", "engine").unwrap();
     let a = a.start().unwrap();
-    let mut b = Bridge::builder(BridgeConfig::new("noalloc", "engine").connect(&ep), &gm_b);
-    b.import::<CommandBuffer<VerbId>>("TB.command").unwrap();
+    let mut b = Bridge::builder(
+        BridgeConfig::new("noalloc", "engine")
+            .connect(&ep)
+            .insecure(),
+        &gm_b,
+    );
+    b.import::<CommandBuffer<VerbId>>("TB.command", "helm")
+        .unwrap();
     b.export::<StatusBuffer>("TB.status").unwrap();
     let _b = b.start().unwrap();
     let stop = Arc::new(AtomicBool::new(false));

@@ -10,12 +10,16 @@
 //! `E2: *2 when TB.stale_cycles > 30 -> Error(TURBINE_SILENT)`.
 //!
 //! ```text
-//! cargo run -p submarine-split-example --features zenoh -- helm     # terminal 1: SM + PR, orders TRANSIT(15)
-//! cargo run -p submarine-split-example --features zenoh -- engine   # terminal 2: TB + turbine and ship simulators
+//! cargo run -- certs /tmp/sub examples/submarine-split/plans              # once: a development CA and certificates
+//! cargo run -p submarine-split-example --features zenoh -- helm --certs /tmp/sub     # terminal 1: SM + PR, orders TRANSIT(15)
+//! cargo run -p submarine-split-example --features zenoh -- engine --certs /tmp/sub   # terminal 2: TB + turbine and ship simulators
 //! ```
 //!
-//! `helm` listens on `tcp/127.0.0.1:7447` and `engine` connects to it
-//! (`--listen`/`--connect` change that). `helm` waits for TB's first status,
+//! Every link is mutual TLS, and each process accepts only what the plan
+//! set says its peer writes (the policy rcsc generated; docs/distribution.md
+//! "Security"). `--insecure` instead runs plain TCP without access control,
+//! and says so. `helm` listens on `tls/127.0.0.1:7447` and `engine` connects
+//! to it (`--listen`/`--connect` change that). `helm` waits for TB's first status,
 //! orders `SM <- TRANSIT(speed)`, and prints a line whenever a status
 //! changes; `transit KNOTS` on its standard input orders again. Stop
 //! `engine` and PR's E2 fires 31 cycles after TB's last status; start it

@@ -21,16 +21,22 @@ use submarine_split::{pr, sm, tb, Hooks, System};
 /// The split submarine with PR's hooks.
 type Sub = System<Propulsion>;
 
-const USAGE: &str = "usage: submarine-split helm|engine|one-process [--listen ENDPOINT] [--connect ENDPOINT] [--speed KNOTS] [--cycles N]
+const USAGE: &str = "usage: submarine-split helm|engine|one-process (--certs DIR | --insecure) [--listen ENDPOINT] [--connect ENDPOINT] [--speed KNOTS] [--cycles N]
 
-  helm         SM and PR; listens on tcp/127.0.0.1:7447; orders SM <- TRANSIT(speed) once TB answers;
+  helm         SM and PR; listens on tls/127.0.0.1:7447; orders SM <- TRANSIT(speed) once TB answers;
                `transit KNOTS` on standard input orders again
-  engine       TB with the turbine and ship simulators; connects to tcp/127.0.0.1:7447
+  engine       TB with the turbine and ship simulators; connects to tls/127.0.0.1:7447
   one-process  the whole hierarchy in this process, flat out, until AT_GOAL
-  --cycles N   stop after N cycles (default: run until killed; one-process: 2000)";
+  --certs DIR  mutual TLS with DIR/ca.pem, DIR/PROCESS.pem and DIR/PROCESS.key
+               (`rcsc certs DIR examples/submarine-split/plans` makes development ones),
+               and the access-control policy rcsc generated for the process
+  --insecure   no TLS, no access control (tcp/ endpoints): anyone on the network can command the ship
+  --cycles N   stop after N cycles (default: run until killed; one-process: 2000)
+  --report-every N  also print a `report` line every N cycles: the helm the ship's speed,
+               the engine the turbine's drive, both the bridge's refused samples";
 
-/// The helm's endpoint, which the engine connects to.
-const DEFAULT_ENDPOINT: &str = "tcp/127.0.0.1:7447";
+/// The helm's port, which the engine connects to.
+const DEFAULT_PORT: &str = "127.0.0.1:7447";
 
 // ---------------------------------------------------------------------------
 // PR's hooks and the simulated world (as in examples/submarine)
@@ -117,6 +123,9 @@ struct Options {
     connect: Option<String>,
     speed: f64,
     cycles: Option<u64>,
+    certs: Option<std::path::PathBuf>,
+    insecure: bool,
+    report_every: Option<u64>,
 }
 
 impl Options {
@@ -133,11 +142,25 @@ impl Options {
             connect: None,
             speed: 15.0,
             cycles: None,
+            certs: None,
+            insecure: false,
+            report_every: None,
         };
         while let Some(arg) = args.next() {
             let mut value = || args.next().ok_or(format!("{arg} needs a value"));
             match arg.as_str() {
                 "--listen" => opts.listen = Some(value()?),
+                "--certs" => opts.certs = Some(value()?.into()),
+                "--insecure" => opts.insecure = true,
+                "--report-every" => {
+                    let v = value()?;
+                    opts.report_every = Some(
+                        v.parse::<u64>()
+                            .ok()
+                            .filter(|n| *n > 0)
+                            .ok_or(format!("--report-every: `{v}` is not a number of cycles"))?,
+                    );
+                }
                 "--connect" => opts.connect = Some(value()?),
                 "--speed" => {
                     let v = value()?;
@@ -157,19 +180,32 @@ impl Options {
                 other => return Err(format!("unexpected argument `{other}`")),
             }
         }
+        if opts.role != "one-process" && opts.certs.is_some() == opts.insecure {
+            return Err(
+                "choose --certs DIR (mutual TLS and access control) or --insecure (neither)".into(),
+            );
+        }
         Ok(Some(opts))
     }
 
     fn bridge(&self) -> BridgeConfig {
         let mut c = BridgeConfig::new("submarine_split", &self.role);
+        c = match &self.certs {
+            Some(dir) => c.certs(dir),
+            None => c.insecure(),
+        };
+        let default = format!(
+            "{}/{DEFAULT_PORT}",
+            if self.insecure { "tcp" } else { "tls" }
+        );
         let (listen, connect) = match self.role.as_str() {
             "helm" => (
-                Some(self.listen.as_deref().unwrap_or(DEFAULT_ENDPOINT)),
+                Some(self.listen.as_deref().unwrap_or(&default)),
                 self.connect.as_deref(),
             ),
             _ => (
                 self.listen.as_deref(),
-                Some(self.connect.as_deref().unwrap_or(DEFAULT_ENDPOINT)),
+                Some(self.connect.as_deref().unwrap_or(&default)),
             ),
         };
         if let Some(l) = listen {
@@ -246,14 +282,21 @@ fn at_goal(system: &Sub) -> bool {
     system.pr().and_then(pr::Controller::status) == Some(pr::Status::AtGoal)
 }
 
-/// The bridge's refusals, once each (a schema mismatch means the other
-/// process was built from other plans).
-fn report_bridge_errors(bridge: &rcs_runtime::Bridge, shown: &mut usize) {
-    let errors = bridge.errors();
-    for e in errors.iter().skip(*shown) {
-        println!("bridge error: {e}");
+/// The bridge's refusals, a line whenever a count grows (a schema mismatch
+/// means the other process was built from other plans; a wrong writer or a
+/// second writer, that something impersonates a process).
+fn report_bridge_errors(bridge: &rcs_runtime::Bridge, shown: &mut u64) {
+    let refused = bridge.stats().refused;
+    if refused == *shown {
+        return;
     }
-    *shown = (*shown).max(errors.len());
+    *shown = refused;
+    for r in bridge.refusals() {
+        println!(
+            "bridge refused {} sample(s) of {} ({}): {}",
+            r.count, r.buffer, r.kind, r.latest
+        );
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -304,7 +347,7 @@ fn helm(opts: &Options) -> Result<bool, String> {
     let mut last = String::new();
     let mut reached = false;
     let mut goal_seen = false;
-    let mut errors_shown = 0;
+    let mut errors_shown = 0u64;
     let mut cycle = 0u64;
     while opts.cycles.is_none_or(|n| cycle < n) {
         heartbeat.wait();
@@ -319,6 +362,13 @@ fn helm(opts: &Options) -> Result<bool, String> {
         if now != last {
             println!("cycle {cycle} {now} tb_stale={stale}");
             last = now;
+        }
+        if opts.report_every.is_some_and(|n| cycle % n == 0) {
+            let ship = system.pr().map_or(0.0, |c| c.data().reads.ship.speed);
+            println!(
+                "report cycle={cycle} speed={ship:.2} refused={}",
+                bridge.stats().refused
+            );
         }
         if at_goal(&system) && !goal_seen {
             goal_seen = true;
@@ -351,7 +401,7 @@ fn engine(opts: &Options) -> Result<bool, String> {
     println!("engine: running");
     let mut heartbeat = Heartbeat::new(period, Wait::default());
     let mut last = String::new();
-    let mut errors_shown = 0;
+    let mut errors_shown = 0u64;
     let mut cycle = 0u64;
     while opts.cycles.is_none_or(|n| cycle < n) {
         heartbeat.wait();
@@ -363,6 +413,14 @@ fn engine(opts: &Options) -> Result<bool, String> {
         if now != last {
             println!("cycle {cycle} {now}");
             last = now;
+        }
+        if opts.report_every.is_some_and(|n| cycle % n == 0) {
+            let drive = system.outputs.drive.read().value;
+            println!(
+                "report cycle={cycle} rpm_setpoint={:.1} refused={}",
+                drive.rpm_setpoint,
+                bridge.stats().refused
+            );
         }
         report_bridge_errors(&bridge, &mut errors_shown);
         cycle += 1;

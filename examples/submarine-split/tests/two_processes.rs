@@ -84,7 +84,17 @@ impl Drop for Proc {
 
 fn free_endpoint() -> String {
     let l = TcpListener::bind("127.0.0.1:0").expect("bind a free port");
-    format!("tcp/127.0.0.1:{}", l.local_addr().expect("address").port())
+    format!("tls/127.0.0.1:{}", l.local_addr().expect("address").port())
+}
+
+/// A development CA and the certificates of both processes, in a fresh
+/// folder of this test's.
+fn certs(test: &str) -> String {
+    let dir = std::env::temp_dir().join(format!("rcs-split-{test}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    rcs_runtime::acl::certs::make_dev_certs(&dir, &["helm", "engine", "operator"], &[])
+        .expect("make development certificates");
+    dir.display().to_string()
 }
 
 /// The `goal` line of a one-process run of the same plan set.
@@ -104,8 +114,9 @@ fn one_process_goal() -> String {
 #[test]
 fn split_reaches_the_goal_fails_on_a_dead_engine_and_recovers() {
     let ep = free_endpoint();
-    let mut helm = Proc::spawn(&["helm", "--listen", &ep]);
-    let engine = Proc::spawn(&["engine", "--connect", &ep]);
+    let dir = certs("goal");
+    let mut helm = Proc::spawn(&["helm", "--certs", &dir, "--listen", &ep]);
+    let engine = Proc::spawn(&["engine", "--certs", &dir, "--connect", &ep]);
 
     // 1. AT_GOAL across two processes, with the statuses of one process.
     let goal = helm.wait_for("goal line", |l| l.starts_with("goal "));
@@ -131,7 +142,7 @@ fn split_reaches_the_goal_fails_on_a_dead_engine_and_recovers() {
     });
 
     // 3. A new engine and a new order: the hierarchy reaches the goal again.
-    let _engine = Proc::spawn(&["engine", "--connect", &ep]);
+    let _engine = Proc::spawn(&["engine", "--certs", &dir, "--connect", &ep]);
     helm.say("transit 15");
     helm.wait_for("the order", |l| l.starts_with("order "));
     let again = helm.wait_for("goal line after the restart", |l| l.starts_with("goal "));

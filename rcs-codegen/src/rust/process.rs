@@ -80,54 +80,67 @@ pub(crate) fn process_api(
         #(gm.declare_controller::<#modules::Command>(#modules::NAME)?;)*
         #(gm.declare::<#cross_tys>(#cross_names)?;)*
     };
-    let arms = processes.iter().enumerate().map(|(p, process)| {
-        let cpus = executives
-            .iter()
-            .zip(&placement.cpu_process)
-            .filter(|(_, cp)| **cp == p)
-            .map(|(e, _)| e);
-        let bridged = placement
-            .crossings
-            .iter()
-            .zip(&crossings)
-            .filter_map(|(x, (ty, name))| {
-                if x.writer == p {
-                    Some(quote!(bridge.export::<#ty>(#name)?;))
-                } else if x.readers.contains(&p) {
-                    Some(quote!(bridge.import::<#ty>(#name)?;))
-                } else {
-                    None
+    let arms =
+        processes.iter().enumerate().map(|(p, process)| {
+            let cpus = executives
+                .iter()
+                .zip(&placement.cpu_process)
+                .filter(|(_, cp)| **cp == p)
+                .map(|(e, _)| e);
+            let bridged = placement.crossings.iter().zip(&crossings).filter_map(
+                |(x, (ty, name))| {
+                    let writer = processes[x.writer].as_str();
+                    if x.writer == p {
+                        Some(quote!(bridge.export::<#ty>(#name)?;))
+                    } else if !x.readers.contains(&p) {
+                        None
+                    } else if let BufferKind::Status(c) = &x.kind {
+                        // A status the subordinate cannot write is refused.
+                        let [statuses, errors, verbs, states] =
+                            status_ranges(&ir.controllers[c.index()]);
+                        Some(quote! {
+                            bridge.import_checked::<#ty>(#name, #writer, |s: &rt::StatusBuffer| {
+                                s.check_range(#statuses, #errors, #verbs, #states)
+                            })?;
+                        })
+                    } else {
+                        Some(quote!(bridge.import::<#ty>(#name, #writer)?;))
+                    }
+                },
+            );
+            let policy = crate::acl::policy(ir, placement, p).to_string();
+            // The bridge polls at the pace of the fastest CPU elsewhere that
+            // reads what this process writes (1 ms if none).
+            let poll = placement
+                .crossings
+                .iter()
+                .filter(|x| x.writer == p)
+                .flat_map(|x| &x.readers)
+                .flat_map(|r| {
+                    ir.schedule
+                        .iter()
+                        .zip(&placement.cpu_process)
+                        .filter(move |(_, cp)| *cp == r)
+                        .map(|(cpu, _)| cpu.period_ns)
+                })
+                .min()
+                .unwrap_or(1_000_000);
+            quote! {
+                #process => {
+                    if config.poll_period.is_none() {
+                        config.poll_period = Some(::core::time::Duration::from_nanos(#poll));
+                    }
+                    if config.policy.is_none() {
+                        config.policy = Some(#policy.to_owned());
+                    }
+                    #[allow(unused_mut)]
+                    let mut bridge = rt::Bridge::builder(config, &gm);
+                    #(#bridged)*
+                    #(#cpus)*
+                    bridge.start()?
                 }
-            });
-        // The bridge polls at the pace of the fastest CPU elsewhere that
-        // reads what this process writes (1 ms if none).
-        let poll = placement
-            .crossings
-            .iter()
-            .filter(|x| x.writer == p)
-            .flat_map(|x| &x.readers)
-            .flat_map(|r| {
-                ir.schedule
-                    .iter()
-                    .zip(&placement.cpu_process)
-                    .filter(move |(_, cp)| *cp == r)
-                    .map(|(cpu, _)| cpu.period_ns)
-            })
-            .min()
-            .unwrap_or(1_000_000);
-        quote! {
-            #process => {
-                if config.poll_period.is_none() {
-                    config.poll_period = Some(::core::time::Duration::from_nanos(#poll));
-                }
-                #[allow(unused_mut)]
-                let mut bridge = rt::Bridge::builder(config, &gm);
-                #(#bridged)*
-                #(#cpus)*
-                bridge.start()?
             }
-        }
-    });
+        });
     let inputs = ir
         .buffers
         .iter()
@@ -168,7 +181,12 @@ pub(crate) fn process_api(
             /// this process writes (`inputs:` in the manifest), `None` for
             /// the others; `operators` command roots that run here.
             /// `config.poll_period`, when `None`, becomes the period of the
-            /// fastest CPU elsewhere that reads a buffer written here.
+            /// fastest CPU elsewhere that reads a buffer written here;
+            /// `config.policy`, when `None`, becomes this process's
+            /// access-control policy generated from the plan set (it applies
+            /// under `config.security = Security::Tls`, which
+            /// `BridgeConfig::certs` sets; `BridgeConfig::insecure` opts out
+            /// of it, loudly).
             pub fn process(
                 process: &str,
                 mut config: rt::BridgeConfig,
@@ -199,4 +217,17 @@ pub(crate) fn process_api(
             }
         }
     }
+}
+
+/// `[custom statuses, declared errors, verbs, most states of a plan]` of a
+/// controller: the ranges its status buffer can take.
+fn status_ranges(ctrl: &rcs_dsl::ir::Controller) -> [u16; 4] {
+    let n = |x: usize| u16::try_from(x).unwrap_or(u16::MAX);
+    let states = ctrl.plans.iter().map(|p| p.states.len()).max().unwrap_or(0);
+    [
+        n(ctrl.statuses.len()),
+        n(ctrl.errors.len()),
+        n(ctrl.commands.len()),
+        n(states),
+    ]
 }

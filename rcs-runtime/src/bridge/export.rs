@@ -22,6 +22,9 @@ pub(super) trait Export: Send {
 pub(super) struct ExportSlot<T> {
     pub(super) reader: Reader<T>,
     pub(super) last: u64,
+    /// This process's name and the bridge's instance, sent with each sample.
+    pub(super) writer: String,
+    pub(super) instance: u64,
 }
 
 impl<T: BufferData + Schema + Serialize> Export for ExportSlot<T> {
@@ -33,7 +36,7 @@ impl<T: BufferData + Schema + Serialize> Export for ExportSlot<T> {
         let s = self.reader.read();
         self.last = s.generation;
         out.clear();
-        wire::encode(out, T::SCHEMA, &s).is_ok()
+        wire::encode(out, T::SCHEMA, &self.writer, self.instance, &s).is_ok()
     }
 }
 

@@ -54,14 +54,19 @@ use zenoh::pubsub::Subscriber;
 use zenoh::qos::CongestionControl;
 use zenoh::{Session, Wait};
 
+use crate::acl::Security;
 use crate::gm::{BufferData, GlobalMemory};
 use crate::schema::Schema;
 
 pub use config::BridgeConfig;
-pub use error::{BridgeError, BridgeStats};
+pub use error::{BridgeError, BridgeStats, Refusal};
 use error::{Counters, ErrorLog};
 use export::{export_loop, Export, ExportSlot};
-use import::Import;
+pub use import::Check;
+use import::{any_value, Import};
+/// The Zenoh this bridge is built on, for programs that open sessions of
+/// their own beside it (an operator console, tests playing a rogue peer).
+pub use zenoh;
 
 /// An import waiting for [`BridgeBuilder::start`] to declare its subscriber.
 type Declare = Box<dyn FnOnce(&Session, &Shared) -> Result<Subscriber<()>, BridgeError>>;
@@ -79,6 +84,9 @@ pub struct BridgeBuilder<'a> {
     gm: &'a GlobalMemory,
     exports: Vec<(String, Box<dyn Export>)>,
     imports: Vec<Declare>,
+    /// This bridge's random instance number, sent with every sample so that
+    /// importers tell a restarted (or duplicated) writer apart.
+    instance: u64,
 }
 
 impl std::fmt::Debug for BridgeBuilder<'_> {
@@ -101,29 +109,49 @@ impl<'a> BridgeBuilder<'a> {
         let reader = self.gm.reader::<T>(buffer)?;
         self.exports.push((
             self.config.key(buffer),
-            Box::new(ExportSlot { reader, last: 0 }),
+            Box::new(ExportSlot {
+                reader,
+                last: 0,
+                writer: self.config.process.clone(),
+                instance: self.instance,
+            }),
         ));
         Ok(self)
     }
 
-    /// Feed the local buffer `buffer` from the process that writes it.
+    /// Feed the local buffer `buffer` from process `writer`, the one that
+    /// writes it in the plan set (samples naming another are refused).
     /// Takes the buffer's one writer, so nothing in this process can write
     /// it too.
-    pub fn import<T>(&mut self, buffer: &str) -> Result<&mut Self, BridgeError>
+    pub fn import<T>(&mut self, buffer: &str, writer: &str) -> Result<&mut Self, BridgeError>
     where
         T: BufferData + Schema + DeserializeOwned + Sync,
     {
-        let writer = self.gm.writer::<T>(buffer)?;
+        self.import_checked::<T>(buffer, writer, any_value::<T>)
+    }
+
+    /// As [`import`](Self::import), refusing values that `check` rejects
+    /// (the generated code checks the ranges of status buffers).
+    pub fn import_checked<T>(
+        &mut self,
+        buffer: &str,
+        writer: &str,
+        check: Check<T>,
+    ) -> Result<&mut Self, BridgeError>
+    where
+        T: BufferData + Schema + DeserializeOwned + Sync,
+    {
+        let local = self.gm.writer::<T>(buffer)?;
         let key = self.config.key(buffer);
+        let expected = writer.to_owned();
+        // A restarted writer takes the buffer over once the old instance
+        // has missed three resends.
+        let takeover = self.config.resend_period.saturating_mul(3);
         self.imports.push(Box::new(move |session, shared| {
-            let mut import = Import {
-                writer,
-                last: None,
-                shared: shared.clone(),
-            };
+            let mut import = Import::new(local, expected, check, takeover, shared.clone());
             session
                 .declare_subscriber(key)
-                .callback_mut(move |sample| import.receive(&sample.payload().to_bytes()))
+                .callback_mut(move |sample| import.receive(sample.payload()))
                 .wait()
                 .map_err(|e| BridgeError::Zenoh(e.to_string()))
         }));
@@ -133,7 +161,22 @@ impl<'a> BridgeBuilder<'a> {
     /// Open the Zenoh session, declare the subscribers and publishers, and
     /// start the export thread.
     pub fn start(self) -> Result<Bridge, BridgeError> {
-        let session = zenoh::open(self.config.zenoh_config()?)
+        let zenoh_config = self.config.zenoh_config()?;
+        if self.config.security == Security::Insecure {
+            eprintln!(
+                "rcs-runtime: WARNING: process `{}` of system `{}` runs its bridge WITHOUT TLS, \
+                 authentication or access control (BridgeConfig::insecure): anyone who reaches \
+                 {} can read every buffer and command every controller",
+                self.config.process,
+                self.config.system,
+                if self.config.listen.is_empty() {
+                    "its peers".to_string()
+                } else {
+                    self.config.listen.join(", ")
+                }
+            );
+        }
+        let session = zenoh::open(zenoh_config)
             .wait()
             .map_err(|e| BridgeError::Zenoh(e.to_string()))?;
         let shared = Shared {
@@ -204,6 +247,7 @@ impl Bridge {
             gm,
             exports: Vec::new(),
             imports: Vec::new(),
+            instance: random_instance(),
         }
     }
 
@@ -212,16 +256,27 @@ impl Bridge {
         &self.config
     }
 
-    /// The latest error each buffer's received samples caused, by buffer
-    /// name. Empty while all is well.
+    /// The latest refusal of each kind for each buffer, by buffer name.
+    /// Empty while all is well.
     pub fn errors(&self) -> Vec<BridgeError> {
-        let map = self
-            .shared
+        self.shared
             .errors
-            .latest
-            .lock()
-            .unwrap_or_else(|p| p.into_inner());
-        map.values().cloned().collect()
+            .refusals()
+            .into_iter()
+            .map(|r| r.latest)
+            .collect()
+    }
+
+    /// Every refused sample, counted by buffer and kind, with the latest
+    /// of each (for the console and the importing process's status).
+    pub fn refusals(&self) -> Vec<Refusal> {
+        self.shared.errors.refusals()
+    }
+
+    /// Whether this bridge runs without TLS and access control
+    /// ([`BridgeConfig::insecure`]).
+    pub fn is_insecure(&self) -> bool {
+        self.config.security == Security::Insecure
     }
 
     /// Counters: samples published, imported, refused.
@@ -229,8 +284,14 @@ impl Bridge {
         BridgeStats {
             published: self.shared.counters.published.load(Ordering::Relaxed),
             imported: self.shared.counters.imported.load(Ordering::Relaxed),
+            received: self.shared.counters.received.load(Ordering::Relaxed),
             refused: self.shared.errors.refused.load(Ordering::Relaxed),
         }
+    }
+
+    /// How many peer processes this bridge's session is connected to now.
+    pub fn peers(&self) -> usize {
+        self.session.info().peers_zid().wait().count()
     }
 
     /// The name of the export thread, `rcs-bridge-<process>` (what
@@ -251,4 +312,19 @@ impl Drop for Bridge {
         }
         let _ = self.session.close().wait();
     }
+}
+
+/// A random number for this bridge instance: the standard library's
+/// randomly keyed hasher over the time and the process id (no dependency,
+/// and no need for more than "different from the last run").
+fn random_instance() -> u64 {
+    use std::hash::{BuildHasher, Hasher};
+    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+    h.write_u128(
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos()),
+    );
+    h.write_u32(std::process::id());
+    h.finish()
 }

@@ -224,20 +224,23 @@ fn dress(config: BridgeConfig, disguise: &Disguise) -> BridgeConfig {
     }
 }
 
-/// A raw Zenoh session of the rogue's: subscribes to `rcs/**` and floods
-/// `TB.status` with junk for about a second. Returns how many samples the
-/// subscription received.
+/// Two raw Zenoh sessions of the rogue's: one subscribes to `rcs/**`, the
+/// other floods `TB.status` with junk for about a second. Returns how many
+/// samples the subscription received (none of them its own: two sessions).
 fn snoop_and_flood(disguise: &Disguise, endpoint: &str) -> u64 {
-    let config = dress(
-        BridgeConfig::new(SYSTEM, "rogue").connect(endpoint),
-        disguise,
-    );
-    let session = zenoh::open(config.zenoh_config().expect("rogue config"))
-        .wait()
-        .expect("the rogue's session opens");
+    let open = || {
+        let config = dress(
+            BridgeConfig::new(SYSTEM, "rogue").connect(endpoint),
+            disguise,
+        );
+        zenoh::open(config.zenoh_config().expect("rogue config"))
+            .wait()
+            .expect("the rogue's session opens")
+    };
+    let (snoop, flood) = (open(), open());
     let received = Arc::new(AtomicU64::new(0));
     let count = Arc::clone(&received);
-    let _sub = session
+    let sub = snoop
         .declare_subscriber(format!("rcs/{SYSTEM}/**"))
         .callback(move |_| {
             count.fetch_add(1, Ordering::Relaxed);
@@ -248,12 +251,14 @@ fn snoop_and_flood(disguise: &Disguise, endpoint: &str) -> u64 {
     let junk = vec![0xA5u8; 4096];
     let start = Instant::now();
     while start.elapsed() < Duration::from_secs(1) {
-        let _ = session.put(&key, junk.clone()).wait();
+        let _ = flood.put(&key, junk.clone()).wait();
     }
+    let _ = flood.close().wait();
     // Two seconds of the hierarchy's traffic for the subscription to see.
     std::thread::sleep(Duration::from_secs(2));
+    drop(sub);
     let n = received.load(Ordering::Relaxed);
-    let _ = session.close().wait();
+    let _ = snoop.close().wait();
     n
 }
 

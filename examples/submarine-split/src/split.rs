@@ -365,9 +365,10 @@ fn helm(opts: &Options) -> Result<bool, String> {
         }
         if opts.report_every.is_some_and(|n| cycle % n == 0) {
             let ship = system.pr().map_or(0.0, |c| c.data().reads.ship.speed);
+            let stats = bridge.stats();
             println!(
-                "report cycle={cycle} speed={ship:.2} refused={}",
-                bridge.stats().refused
+                "report cycle={cycle} speed={ship:.2} tb_stale={stale} received={} imported={} refused={}",
+                stats.received, stats.imported, stats.refused
             );
         }
         if at_goal(&system) && !goal_seen {

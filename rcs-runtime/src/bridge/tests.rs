@@ -402,3 +402,34 @@ fn a_bridge_without_chosen_security_refuses_to_start() {
     let e = Bridge::builder(c, &gm).start().unwrap_err();
     assert!(e.to_string().contains("cannot read"), "{e}");
 }
+
+#[test]
+fn a_restarted_writer_process_is_heard_again() {
+    // A listens and imports; B exports, dies, and a new B (a new bridge
+    // instance, counting from 1 again) takes over once the old one has been
+    // silent for three resends.
+    let (ca, cb) = pair("restart");
+    let gm_a = GlobalMemory::new();
+    gm_a.declare::<Ship>("ship").unwrap();
+    let mut ba = Bridge::builder(ca, &gm_a);
+    ba.import::<Ship>("ship", "b").unwrap();
+    let ba = ba.start().unwrap();
+    let r = gm_a.reader::<Ship>("ship").unwrap();
+    for life in 1..=2u64 {
+        let gm_b = GlobalMemory::new();
+        gm_b.declare::<Ship>("ship").unwrap();
+        let mut w = gm_b.writer::<Ship>("ship").unwrap();
+        let mut bb = Bridge::builder(cb.clone(), &gm_b);
+        bb.export::<Ship>("ship").unwrap();
+        let bb = bb.start().unwrap();
+        let mut i = 0;
+        within("the value of this life", || {
+            i += 1;
+            w.write(ship(life * 1000 + i), i);
+            std::thread::sleep(Duration::from_millis(5));
+            (r.read().value.count > life * 1000).then_some(())
+        });
+        drop(bb);
+    }
+    assert!(ba.errors().iter().all(|e| e.kind() == "second_writer"));
+}

@@ -6,7 +6,9 @@ use std::process::ExitCode;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use rcs_runtime::{BridgeConfig, Heartbeat, StatusBuffer, Wait};
+use rcs_runtime::{BridgeConfig, CommandBuffer, Heartbeat, StatusBuffer, Wait};
+
+use crate::generations::{GenerationWatch, SUMMARY_EVERY};
 
 /// The generated plan set: this binary uses only part of its API.
 #[allow(dead_code)]
@@ -21,13 +23,21 @@ use submarine_split::{pr, sm, tb, Hooks, System};
 /// The split submarine with PR's hooks.
 type Sub = System<Propulsion>;
 
-const USAGE: &str = "usage: submarine-split helm|engine|one-process [--listen ENDPOINT] [--connect ENDPOINT] [--speed KNOTS] [--cycles N]
+const USAGE: &str = "usage: submarine-split helm|engine|one-process [--listen ENDPOINT] [--connect ENDPOINT] [--speed KNOTS] [--cycles N] [--report-generations]
 
   helm         SM and PR; listens on tcp/127.0.0.1:7447; orders SM <- TRANSIT(speed) once TB answers;
                `transit KNOTS` on standard input orders again
   engine       TB with the turbine and ship simulators; connects to tcp/127.0.0.1:7447
   one-process  the whole hierarchy in this process, flat out, until AT_GOAL
-  --cycles N   stop after N cycles (default: run until killed; one-process: 2000)";
+  --cycles N   stop after N cycles (default: run until killed; one-process: 2000)
+  --report-generations
+               check every cycle that the stamps of the buffers the bridge imports never go
+               back; print `out of order: …` if they do and a `generations …` summary every
+               100 cycles (the fault tests use it)";
+
+/// PR's watchdog row E2 fires when `TB.stale_cycles` exceeds this
+/// (`plans/propulsion.rcs`).
+const WATCHDOG_BOUND: u32 = 30;
 
 /// The helm's endpoint, which the engine connects to.
 const DEFAULT_ENDPOINT: &str = "tcp/127.0.0.1:7447";
@@ -117,6 +127,7 @@ struct Options {
     connect: Option<String>,
     speed: f64,
     cycles: Option<u64>,
+    report_generations: bool,
 }
 
 impl Options {
@@ -133,10 +144,12 @@ impl Options {
             connect: None,
             speed: 15.0,
             cycles: None,
+            report_generations: false,
         };
         while let Some(arg) = args.next() {
             let mut value = || args.next().ok_or(format!("{arg} needs a value"));
             match arg.as_str() {
+                "--report-generations" => opts.report_generations = true,
                 "--listen" => opts.listen = Some(value()?),
                 "--connect" => opts.connect = Some(value()?),
                 "--speed" => {
@@ -277,6 +290,17 @@ fn helm(opts: &Options) -> Result<bool, String> {
         std::thread::sleep(Duration::from_millis(10));
     }
     println!("helm: engine answered");
+    let mut watch = GenerationWatch::new();
+    if opts.report_generations {
+        watch.watch("TB.status", tb_status.clone());
+        watch.watch(
+            "ship",
+            system
+                .gm
+                .reader::<Ship>("ship")
+                .map_err(|e| e.to_string())?,
+        );
+    }
 
     // Orders typed on standard input, read on a thread of their own.
     let (orders, order_rx) = mpsc::channel::<f64>();
@@ -305,6 +329,7 @@ fn helm(opts: &Options) -> Result<bool, String> {
     let mut reached = false;
     let mut goal_seen = false;
     let mut errors_shown = 0;
+    let mut silent = 0u32;
     let mut cycle = 0u64;
     while opts.cycles.is_none_or(|n| cycle < n) {
         heartbeat.wait();
@@ -319,6 +344,18 @@ fn helm(opts: &Options) -> Result<bool, String> {
         if now != last {
             println!("cycle {cycle} {now} tb_stale={stale}");
             last = now;
+        }
+        // Past PR's watchdog bound (E2: > 30) and news again: say so, for
+        // whoever waits to order again.
+        if stale == 0 && silent > WATCHDOG_BOUND {
+            println!("helm: engine answered again after {silent} silent cycles");
+        }
+        silent = stale;
+        if opts.report_generations {
+            watch.check();
+            if (cycle + 1).is_multiple_of(SUMMARY_EVERY) || opts.cycles == Some(cycle + 1) {
+                println!("{}", watch.summary(cycle + 1, Some(stale)));
+            }
         }
         if at_goal(&system) && !goal_seen {
             goal_seen = true;
@@ -348,6 +385,15 @@ fn engine(opts: &Options) -> Result<bool, String> {
     };
     ship.write(plant.ship(), 0);
     turbine.write(plant.turbine(), 0);
+    let mut watch = GenerationWatch::new();
+    if opts.report_generations {
+        let name = rcs_runtime::command_buffer_name(tb::NAME);
+        let reader = system
+            .gm
+            .reader::<CommandBuffer<tb::Command>>(&name)
+            .map_err(|e| e.to_string())?;
+        watch.watch(&name, reader);
+    }
     println!("engine: running");
     let mut heartbeat = Heartbeat::new(period, Wait::default());
     let mut last = String::new();
@@ -363,6 +409,12 @@ fn engine(opts: &Options) -> Result<bool, String> {
         if now != last {
             println!("cycle {cycle} {now}");
             last = now;
+        }
+        if opts.report_generations {
+            watch.check();
+            if (cycle + 1).is_multiple_of(SUMMARY_EVERY) || opts.cycles == Some(cycle + 1) {
+                println!("{}", watch.summary(cycle + 1, None));
+            }
         }
         report_bridge_errors(&bridge, &mut errors_shown);
         cycle += 1;

@@ -162,6 +162,24 @@ fn helm_and_engine_joined(test: &str, tag: &str) -> Option<Netns> {
     Some(ns)
 }
 
+/// The bytes through the helm's end of the link while the helm runs 100
+/// cycles (from one `generations` summary to the next), as a figure.
+fn traffic(ns: &Netns, helm: &mut Proc, what: &str) -> String {
+    let summary = |l: &str| l.starts_with("generations ");
+    helm.wait_for("a generations summary", summary);
+    let (rx0, tx0) = ns.bytes("helm", "to-engine");
+    let t0 = Instant::now();
+    helm.wait_for("a generations summary", summary);
+    let (rx1, tx1) = ns.bytes("helm", "to-engine");
+    let secs = t0.elapsed().as_secs_f64();
+    format!(
+        "{what}, at the helm's end over 100 cycles ({secs:.1} s): \
+         {:.0} B/s engine→helm, {:.0} B/s helm→engine",
+        (rx1 - rx0) as f64 / secs,
+        (tx1 - tx0) as f64 / secs,
+    )
+}
+
 /// Both ends of the helm–engine link limited to `rate` by `tbf`.
 fn thin_link(ns: &Netns, rate: &str) {
     for (role, ifc) in [("helm", "to-engine"), ("engine", "to-helm")] {
@@ -185,10 +203,11 @@ fn print_figures(test: &str, figures: &[String]) {
 /// reaches the goal after it), then the link gets thin (tbf 64 kbit): an
 /// order still reaches the goal, and so does the next order after a 3 s
 /// partition of the thin link (whose backlog drains through it). Where the
-/// kernel has `netem`, both ends also get 20 ± 5 ms of delay throughout.
+/// kernel has `netem`, both ends also get 20 ± 5 ms of delay until the
+/// link gets thin.
 #[test]
-fn partition_link_down_fires_the_watchdog_then_heals_and_a_thin_link_converges() {
-    let test = "partition_link_down_fires_the_watchdog_then_heals_and_a_thin_link_converges";
+fn netns_partition_link_down_fires_the_watchdog_then_heals_and_a_thin_link_converges() {
+    let test = "netns_partition_link_down_fires_the_watchdog_then_heals_and_a_thin_link_converges";
     let Some(ns) = helm_and_engine_joined(test, "part") else {
         return;
     };
@@ -218,6 +237,7 @@ fn partition_link_down_fires_the_watchdog_then_heals_and_a_thin_link_converges()
         "first goal {:.2} s after start",
         started.elapsed().as_secs_f64()
     ));
+    figures.push(traffic(&ns, &mut helm, "the bridge's traffic"));
 
     // A 3 s partition: the engine's end of the link goes down.
     let r = silence_and_recover(
@@ -232,7 +252,6 @@ fn partition_link_down_fires_the_watchdog_then_heals_and_a_thin_link_converges()
 
     // A thin link: 64 kbit each way; an order still reaches the goal.
     thin_link(&ns, "64kbit");
-    let bytes_before = ns.bytes("helm", "to-engine");
     let ordered = Instant::now();
     helm.say("transit 10");
     helm.wait_for("the order", |l| l.starts_with("order "));
@@ -262,12 +281,10 @@ fn partition_link_down_fires_the_watchdog_then_heals_and_a_thin_link_converges()
         |()| ns.link("engine", "to-helm", true),
     );
     figures.push(r.figure("partition (link down 3 s) of the thin link"));
-    let bytes_after = ns.bytes("helm", "to-engine");
-    let secs = ordered.elapsed().as_secs_f64();
-    figures.push(format!(
-        "thin link traffic at the helm's end: {:.0} B/s in, {:.0} B/s out over {secs:.1} s",
-        (bytes_after.0 - bytes_before.0) as f64 / secs,
-        (bytes_after.1 - bytes_before.1) as f64 / secs,
+    figures.push(traffic(
+        &ns,
+        &mut helm,
+        "the bridge's traffic on the thin link",
     ));
 
     figures.extend(assert_healthy_and_in_order(&mut [&mut helm, &mut engine]));
@@ -399,7 +416,7 @@ fn netns_relay_delay_stall_reset_and_reordered_attempts_recover() {
 }
 
 /// A link thinner than what the bridge sends (the engine publishes TB.status
-/// and `ship` every cycle: about 2.8 kB/s, 22 kbit/s, on the wire) but wide
+/// and `ship` every cycle: about 4 kB/s, 32 kbit/s, on the wire) but wide
 /// enough for a fresh value many times per watchdog period: 16 kbit. A
 /// latest-value bridge should drop what the link cannot carry and keep the
 /// engine heard; PR's watchdog should not fire while the engine runs, and

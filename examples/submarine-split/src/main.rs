@@ -26,10 +26,19 @@
 //! again and order again: the hierarchy recovers. `one-process` runs the same
 //! plan set with `System::new` in one process, flat out, for comparison.
 //!
+//! `--report-generations` makes both processes check, every cycle, that
+//! what the bridge imports never arrives out of order (`generations.rs`;
+//! the fault tests in `tests/netns_faults.rs` use it). The crate's second
+//! binary, `fault-relay` (`src/bin/fault_relay.rs`), is those tests' TCP
+//! relay that injects delays, stalls, resets and reordered connection
+//! attempts between the two processes.
+//!
 //! Everything lives in `split.rs`, behind this crate's feature `zenoh`
 //! (which turns on `rcs-runtime/zenoh`): a workspace build without it
 //! compiles nothing from Zenoh.
 
+#[cfg(feature = "zenoh")]
+mod generations;
 #[cfg(feature = "zenoh")]
 mod split;
 

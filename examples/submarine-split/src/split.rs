@@ -6,7 +6,9 @@ use std::process::ExitCode;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use rcs_runtime::{BridgeConfig, Heartbeat, StatusBuffer, Wait};
+use rcs_runtime::{BridgeConfig, CommandBuffer, Heartbeat, StatusBuffer, Wait};
+
+use crate::generations::{GenerationWatch, SUMMARY_EVERY};
 
 /// The generated plan set: this binary uses only part of its API.
 #[allow(dead_code)]
@@ -21,7 +23,7 @@ use submarine_split::{pr, sm, tb, Hooks, System};
 /// The split submarine with PR's hooks.
 type Sub = System<Propulsion>;
 
-const USAGE: &str = "usage: submarine-split helm|engine|one-process (--certs DIR | --insecure) [--listen ENDPOINT] [--connect ENDPOINT] [--speed KNOTS] [--cycles N]
+const USAGE: &str = "usage: submarine-split helm|engine|one-process (--certs DIR | --insecure) [--listen ENDPOINT] [--connect ENDPOINT] [--speed KNOTS] [--cycles N] [--report-every N] [--report-generations]
 
   helm         SM and PR; listens on tls/127.0.0.1:7447; orders SM <- TRANSIT(speed) once TB answers;
                `transit KNOTS` on standard input orders again
@@ -33,7 +35,15 @@ const USAGE: &str = "usage: submarine-split helm|engine|one-process (--certs DIR
   --insecure   no TLS, no access control (tcp/ endpoints): anyone on the network can command the ship
   --cycles N   stop after N cycles (default: run until killed; one-process: 2000)
   --report-every N  also print a `report` line every N cycles: the helm the ship's speed,
-               the engine the turbine's drive, both the bridge's refused samples";
+               the engine the turbine's drive, both the bridge's refused samples
+  --report-generations
+               check every cycle that the stamps of the buffers the bridge imports never go
+               back; print `out of order: …` if they do and a `generations …` summary every
+               100 cycles (the fault tests use it)";
+
+/// PR's watchdog row E2 fires when `TB.stale_cycles` exceeds this
+/// (`plans/propulsion.rcs`).
+const WATCHDOG_BOUND: u32 = 30;
 
 /// The helm's port, which the engine connects to.
 const DEFAULT_PORT: &str = "127.0.0.1:7447";
@@ -126,6 +136,7 @@ struct Options {
     certs: Option<std::path::PathBuf>,
     insecure: bool,
     report_every: Option<u64>,
+    report_generations: bool,
 }
 
 impl Options {
@@ -145,10 +156,12 @@ impl Options {
             certs: None,
             insecure: false,
             report_every: None,
+            report_generations: false,
         };
         while let Some(arg) = args.next() {
             let mut value = || args.next().ok_or(format!("{arg} needs a value"));
             match arg.as_str() {
+                "--report-generations" => opts.report_generations = true,
                 "--listen" => opts.listen = Some(value()?),
                 "--certs" => opts.certs = Some(value()?.into()),
                 "--insecure" => opts.insecure = true,
@@ -320,6 +333,17 @@ fn helm(opts: &Options) -> Result<bool, String> {
         std::thread::sleep(Duration::from_millis(10));
     }
     println!("helm: engine answered");
+    let mut watch = GenerationWatch::new();
+    if opts.report_generations {
+        watch.watch("TB.status", tb_status.clone());
+        watch.watch(
+            "ship",
+            system
+                .gm
+                .reader::<Ship>("ship")
+                .map_err(|e| e.to_string())?,
+        );
+    }
 
     // Orders typed on standard input, read on a thread of their own.
     let (orders, order_rx) = mpsc::channel::<f64>();
@@ -348,6 +372,7 @@ fn helm(opts: &Options) -> Result<bool, String> {
     let mut reached = false;
     let mut goal_seen = false;
     let mut errors_shown = 0u64;
+    let mut silent = 0u32;
     let mut cycle = 0u64;
     while opts.cycles.is_none_or(|n| cycle < n) {
         heartbeat.wait();
@@ -370,6 +395,18 @@ fn helm(opts: &Options) -> Result<bool, String> {
                 "report cycle={cycle} speed={ship:.2} tb_stale={stale} received={} imported={} refused={}",
                 stats.received, stats.imported, stats.refused
             );
+        }
+        // Past PR's watchdog bound (E2: > 30) and news again: say so, for
+        // whoever waits to order again.
+        if stale == 0 && silent > WATCHDOG_BOUND {
+            println!("helm: engine answered again after {silent} silent cycles");
+        }
+        silent = stale;
+        if opts.report_generations {
+            watch.check();
+            if (cycle + 1).is_multiple_of(SUMMARY_EVERY) || opts.cycles == Some(cycle + 1) {
+                println!("{}", watch.summary(cycle + 1, Some(stale)));
+            }
         }
         if at_goal(&system) && !goal_seen {
             goal_seen = true;
@@ -399,6 +436,15 @@ fn engine(opts: &Options) -> Result<bool, String> {
     };
     ship.write(plant.ship(), 0);
     turbine.write(plant.turbine(), 0);
+    let mut watch = GenerationWatch::new();
+    if opts.report_generations {
+        let name = rcs_runtime::command_buffer_name(tb::NAME);
+        let reader = system
+            .gm
+            .reader::<CommandBuffer<tb::Command>>(&name)
+            .map_err(|e| e.to_string())?;
+        watch.watch(&name, reader);
+    }
     println!("engine: running");
     let mut heartbeat = Heartbeat::new(period, Wait::default());
     let mut last = String::new();
@@ -422,6 +468,12 @@ fn engine(opts: &Options) -> Result<bool, String> {
                 drive.rpm_setpoint,
                 bridge.stats().refused
             );
+        }
+        if opts.report_generations {
+            watch.check();
+            if (cycle + 1).is_multiple_of(SUMMARY_EVERY) || opts.cycles == Some(cycle + 1) {
+                println!("{}", watch.summary(cycle + 1, None));
+            }
         }
         report_bridge_errors(&bridge, &mut errors_shown);
         cycle += 1;

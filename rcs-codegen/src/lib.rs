@@ -105,6 +105,10 @@ pub fn generate_with(ir: &Ir, options: &Options) -> Vec<OutputFile> {
                 contents: acl::zenoh_config_file(ir, &placement, p),
             });
         }
+        files.push(OutputFile {
+            path: format!("zenoh/{}.json5", acl::OPERATOR),
+            contents: acl::operator_config_file(ir, &placement),
+        });
     }
     files.push(OutputFile {
         path: "graphs/hierarchy.dot".to_string(),

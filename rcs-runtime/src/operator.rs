@@ -6,8 +6,17 @@
 //! writer of the root's command buffer and follows the same handshake as a
 //! controller, so the human never bypasses the chain of command. An
 //! [`Operator`] is `Send` and works from any thread.
+//!
+//! In a distributed plan set the operator may also sit in another process
+//! (a console): the bridge of the root's process then shares the root's
+//! command writer with the local [`Operator`] and writes the remote
+//! operator's commands through it (`BridgeBuilder::import_operator`), so the
+//! root still has one writer. Commanding is not the cycle path: the short
+//! lock around the write is taken only by the two operators.
 
-use crate::gm::{GlobalMemory, Reader, Stamped};
+use std::sync::{Arc, Mutex};
+
+use crate::gm::{GlobalMemory, Reader, Stamped, Writer};
 use crate::handshake::{
     Command, CommandBuffer, ErrorCode, Status, StatusBuffer, SubordinateLink, SubordinateView,
 };
@@ -17,7 +26,7 @@ use crate::SetupError;
 #[derive(Debug)]
 pub struct Operator<C: Command> {
     link: SubordinateLink,
-    command: crate::gm::Writer<CommandBuffer<C>>,
+    command: Arc<Mutex<Writer<CommandBuffer<C>>>>,
     status: Reader<StatusBuffer>,
     sent: u64,
 }
@@ -29,7 +38,7 @@ impl<C: Command> Operator<C> {
         gm.declare_controller::<C>(root)?;
         Ok(Self {
             link: SubordinateLink::new(),
-            command: gm.command_writer(root)?,
+            command: Arc::new(Mutex::new(gm.command_writer(root)?)),
             status: gm.status_reader(root)?,
             sent: 0,
         })
@@ -40,8 +49,8 @@ impl<C: Command> Operator<C> {
     pub fn command(&mut self, command: C) -> u32 {
         let serial = self.link.next_command();
         self.sent = self.sent.wrapping_add(1);
-        self.command
-            .write(CommandBuffer { serial, command }, self.sent);
+        let mut writer = self.command.lock().unwrap_or_else(|p| p.into_inner());
+        writer.write(CommandBuffer { serial, command }, self.sent);
         serial
     }
 
@@ -74,6 +83,13 @@ impl<C: Command> Operator<C> {
     /// Serial of the last command sent (0: none).
     pub fn last_serial(&self) -> u32 {
         self.link.last_sent()
+    }
+
+    /// The root's command writer, shared with the bridge that takes a
+    /// remote operator's commands for this root.
+    #[cfg(feature = "zenoh")]
+    pub(crate) fn shared_writer(&self) -> Arc<Mutex<Writer<CommandBuffer<C>>>> {
+        Arc::clone(&self.command)
     }
 
     /// Start serials after `serial` (e.g. to test wrap-around).

@@ -25,6 +25,8 @@
 //!   buffer's type (`low_pass_filter`), so a flood of large junk costs the
 //!   receiver no decoding.
 //!
+//! The operator's own program gets [`operator_policy`], the mirror image.
+//!
 //! Deterministic: rules, subjects and keys come out in placement order.
 
 use rcs_dsl::ir::{Ir, Type};
@@ -115,6 +117,12 @@ pub fn policy(ir: &Ir, placement: &Placement, process: usize) -> Value {
         .collect();
     let ids: Vec<String> = [
         rule(
+            format!("commands_from_{OPERATOR}"),
+            "egress",
+            "declare_subscriber",
+            root_commands.clone(),
+        ),
+        rule(
             format!("{OPERATOR}_may_command"),
             "ingress",
             "put",
@@ -168,6 +176,78 @@ pub fn policy(ir: &Ir, placement: &Placement, process: usize) -> Value {
     })
 }
 
+/// The policy of the operator (a console, or any program commanding the
+/// roots from a process of its own): per process, it may put the command
+/// buffers of the roots that run there and subscribe to the status buffers
+/// of that process's controllers, and nothing else.
+pub fn operator_policy(ir: &Ir, placement: &Placement) -> Value {
+    let key = |b: String| format!("rcs/{}/{}", ir.system, b);
+    let mut rules: Vec<Value> = Vec::new();
+    let mut policies: Vec<Value> = Vec::new();
+    for (p, process) in placement.processes.iter().enumerate() {
+        let here = (0..ir.controllers.len()).filter(|&c| placement.ctrl_process[c] == p);
+        let commands: Vec<String> = here
+            .clone()
+            .filter(|&c| ir.controllers[c].supervisor.is_none())
+            .map(|c| key(format!("{}.command", ir.controllers[c].name)))
+            .collect();
+        let statuses: Vec<String> = here
+            .map(|c| key(format!("{}.status", ir.controllers[c].name)))
+            .collect();
+        let mut ids = Vec::new();
+        for (id, flow, message, keys) in [
+            (
+                format!("{process}_may_subscribe"),
+                "ingress",
+                "declare_subscriber",
+                &commands,
+            ),
+            (format!("command_{process}"), "egress", "put", &commands),
+            (
+                format!("statuses_of_{process}"),
+                "ingress",
+                "put",
+                &statuses,
+            ),
+            (
+                format!("subscribe_at_{process}"),
+                "egress",
+                "declare_subscriber",
+                &statuses,
+            ),
+        ] {
+            if keys.is_empty() {
+                continue;
+            }
+            rules.push(json!({
+                "id": id,
+                "flows": [flow],
+                "messages": [message],
+                "permission": "allow",
+                "key_exprs": keys,
+            }));
+            ids.push(id);
+        }
+        if !ids.is_empty() {
+            policies.push(json!({ "subjects": [process], "rules": ids }));
+        }
+    }
+    let subjects: Vec<Value> = placement
+        .processes
+        .iter()
+        .map(|p| json!({ "id": p, "cert_common_names": [p] }))
+        .collect();
+    json!({
+        "access_control": {
+            "enabled": true,
+            "default_permission": "deny",
+            "rules": rules,
+            "subjects": subjects,
+            "policies": policies,
+        },
+    })
+}
+
 /// A whole Zenoh configuration of process `process` (JSON5 with a header
 /// comment): peer mode, scouting off, mutual TLS with the files `rcsc
 /// certs` writes (paths relative to where the process runs: edit them for
@@ -175,8 +255,17 @@ pub fn policy(ir: &Ir, placement: &Placement, process: usize) -> Value {
 /// its `BridgeConfig`; this file is for Zenoh tools and reviews.
 pub fn zenoh_config_file(ir: &Ir, placement: &Placement, process: usize) -> String {
     let name = &placement.processes[process];
-    let Value::Object(policy) = policy(ir, placement, process) else {
-        unreachable!("policy() builds an object")
+    config_file(ir, name, policy(ir, placement, process))
+}
+
+/// The whole Zenoh configuration of the operator (`zenoh/operator.json5`).
+pub fn operator_config_file(ir: &Ir, placement: &Placement) -> String {
+    config_file(ir, OPERATOR, operator_policy(ir, placement))
+}
+
+fn config_file(ir: &Ir, name: &str, policy: Value) -> String {
+    let Value::Object(policy) = policy else {
+        unreachable!("policies are objects")
     };
     let mut config = json!({
         "mode": "peer",
@@ -199,9 +288,9 @@ pub fn zenoh_config_file(ir: &Ir, placement: &Placement, process: usize) -> Stri
     }
     let body = serde_json::to_string_pretty(&config).unwrap_or_default();
     format!(
-        "// {} — Zenoh configuration of process `{name}` of system `{}`.\n\
-         // Access control from the plan set: default deny; each peer process may put\n\
-         // and subscribe only to the buffers the plan set says it writes and reads.\n\
+        "// {} — Zenoh configuration of `{name}` in system `{}`.\n\
+         // Access control from the plan set: default deny; each peer may put and\n\
+         // subscribe only to the buffers the plan set says it writes and reads.\n\
          // Listen/connect endpoints are the deployment's: add `listen`/`connect`.\n\
          {body}\n",
         crate::GENERATED,

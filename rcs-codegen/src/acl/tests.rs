@@ -82,12 +82,9 @@ fn expected(ir: &Ir, pl: &Placement, p: usize) -> BTreeSet<(String, String, Stri
         add(OPERATOR, "egress", "put", status.clone());
         add(OPERATOR, "ingress", "declare_subscriber", status);
         if ctrl.supervisor.is_none() {
-            add(
-                OPERATOR,
-                "ingress",
-                "put",
-                format!("rcs/{}/{}.command", ir.system, ctrl.name),
-            );
+            let command = format!("rcs/{}/{}.command", ir.system, ctrl.name);
+            add(OPERATOR, "ingress", "put", command.clone());
+            add(OPERATOR, "egress", "declare_subscriber", command);
         }
     }
     out
@@ -144,4 +141,29 @@ fn each_put_has_a_size_limit_and_the_file_is_a_zenoh_config() {
     assert_eq!(v["mode"], "peer");
     assert_eq!(v["transport"]["link"]["tls"]["enable_mtls"], true);
     assert_eq!(v["access_control"], policy["access_control"]);
+}
+
+#[test]
+fn the_operator_policy_mirrors_the_processes() {
+    let ir = split_submarine();
+    let pl = Placement::of(&ir);
+    let op = allowed(&operator_policy(&ir, &pl));
+    // Every permission a process grants the operator, the operator holds
+    // in the opposite direction, and nothing more.
+    let flip = |f: &str| if f == "ingress" { "egress" } else { "ingress" };
+    let mut mirrored = BTreeSet::new();
+    for (p, process) in pl.processes.iter().enumerate() {
+        for (s, f, m, k) in allowed(&policy(&ir, &pl, p)) {
+            if s == OPERATOR {
+                mirrored.insert((process.clone(), flip(&f).to_owned(), m, k));
+            }
+        }
+    }
+    assert_eq!(op, mirrored);
+    assert!(op.contains(&(
+        "helm".into(),
+        "egress".into(),
+        "put".into(),
+        "rcs/submarine_split/SM.command".into()
+    )));
 }

@@ -80,67 +80,81 @@ pub(crate) fn process_api(
         #(gm.declare_controller::<#modules::Command>(#modules::NAME)?;)*
         #(gm.declare::<#cross_tys>(#cross_names)?;)*
     };
-    let arms =
-        processes.iter().enumerate().map(|(p, process)| {
-            let cpus = executives
-                .iter()
-                .zip(&placement.cpu_process)
-                .filter(|(_, cp)| **cp == p)
-                .map(|(e, _)| e);
-            let bridged = placement.crossings.iter().zip(&crossings).filter_map(
-                |(x, (ty, name))| {
-                    let writer = processes[x.writer].as_str();
-                    if x.writer == p {
-                        Some(quote!(bridge.export::<#ty>(#name)?;))
-                    } else if !x.readers.contains(&p) {
-                        None
-                    } else if let BufferKind::Status(c) = &x.kind {
-                        // A status the subordinate cannot write is refused.
-                        let [statuses, errors, verbs, states] =
-                            status_ranges(&ir.controllers[c.index()]);
-                        Some(quote! {
-                            bridge.import_checked::<#ty>(#name, #writer, |s: &rt::StatusBuffer| {
-                                s.check_range(#statuses, #errors, #verbs, #states)
-                            })?;
-                        })
-                    } else {
-                        Some(quote!(bridge.import::<#ty>(#name, #writer)?;))
-                    }
-                },
-            );
-            let policy = crate::acl::policy(ir, placement, p).to_string();
-            // The bridge polls at the pace of the fastest CPU elsewhere that
-            // reads what this process writes (1 ms if none).
-            let poll = placement
-                .crossings
-                .iter()
-                .filter(|x| x.writer == p)
-                .flat_map(|x| &x.readers)
-                .flat_map(|r| {
-                    ir.schedule
-                        .iter()
-                        .zip(&placement.cpu_process)
-                        .filter(move |(_, cp)| *cp == r)
-                        .map(|(cpu, _)| cpu.period_ns)
-                })
-                .min()
-                .unwrap_or(1_000_000);
-            quote! {
-                #process => {
-                    if config.poll_period.is_none() {
-                        config.poll_period = Some(::core::time::Duration::from_nanos(#poll));
-                    }
-                    if config.policy.is_none() {
-                        config.policy = Some(#policy.to_owned());
-                    }
-                    #[allow(unused_mut)]
-                    let mut bridge = rt::Bridge::builder(config, &gm);
-                    #(#bridged)*
-                    #(#cpus)*
-                    bridge.start()?
+    let arms = processes.iter().enumerate().map(|(p, process)| {
+        let cpus = executives
+            .iter()
+            .zip(&placement.cpu_process)
+            .filter(|(_, cp)| **cp == p)
+            .map(|(e, _)| e);
+        let bridged = placement
+            .crossings
+            .iter()
+            .zip(&crossings)
+            .filter_map(|(x, (ty, name))| {
+                let writer = processes[x.writer].as_str();
+                if x.writer == p {
+                    Some(quote!(bridge.export::<#ty>(#name)?;))
+                } else if !x.readers.contains(&p) {
+                    None
+                } else if let BufferKind::Status(c) = &x.kind {
+                    // A status the subordinate cannot write is refused.
+                    let [statuses, errors, verbs, states] =
+                        status_ranges(&ir.controllers[c.index()]);
+                    Some(quote! {
+                        bridge.import_checked::<#ty>(#name, #writer, |s: &rt::StatusBuffer| {
+                            s.check_range(#statuses, #errors, #verbs, #states)
+                        })?;
+                    })
+                } else {
+                    Some(quote!(bridge.import::<#ty>(#name, #writer)?;))
                 }
+            });
+        let policy = crate::acl::policy(ir, placement, p).to_string();
+        // A remote operator (identity `operator`) commands the roots that
+        // run here through their local operators' writers, and sees their
+        // statuses.
+        let roots = (0..ir.controllers.len())
+            .filter(|&c| placement.ctrl_process[c] == p && ir.controllers[c].supervisor.is_none())
+            .map(|c| {
+                let m = &names.ctrls[c].module;
+                quote! {
+                    bridge.import_operator::<#m::Command>(#m::NAME, &operators.#m)?;
+                    bridge.export::<rt::StatusBuffer>(&rt::status_buffer_name(#m::NAME))?;
+                }
+            });
+        // The bridge polls at the pace of the fastest CPU elsewhere that
+        // reads what this process writes (1 ms if none).
+        let poll = placement
+            .crossings
+            .iter()
+            .filter(|x| x.writer == p)
+            .flat_map(|x| &x.readers)
+            .flat_map(|r| {
+                ir.schedule
+                    .iter()
+                    .zip(&placement.cpu_process)
+                    .filter(move |(_, cp)| *cp == r)
+                    .map(|(cpu, _)| cpu.period_ns)
+            })
+            .min()
+            .unwrap_or(1_000_000);
+        quote! {
+            #process => {
+                if config.poll_period.is_none() {
+                    config.poll_period = Some(::core::time::Duration::from_nanos(#poll));
+                }
+                if config.policy.is_none() {
+                    config.policy = Some(#policy.to_owned());
+                }
+                #[allow(unused_mut)]
+                let mut bridge = rt::Bridge::builder(config, &gm);
+                #(#bridged)*
+                #(#roots)*
+                #(#cpus)*
+                bridge.start()?
             }
-        });
+        }
+    });
     let inputs = ir
         .buffers
         .iter()
@@ -166,7 +180,56 @@ pub(crate) fn process_api(
         hooks_param,
         ..
     } = sh;
+    // The operator in a process of its own: every root's command out,
+    // every root's status in, under the operator's policy.
+    let operator_policy = crate::acl::operator_policy(ir, placement).to_string();
+    let remote_roots = (0..ir.controllers.len())
+        .filter(|&c| ir.controllers[c].supervisor.is_none())
+        .map(|c| {
+            let m = &names.ctrls[c].module;
+            let process = processes[placement.ctrl_process[c]].as_str();
+            let [statuses, errors, verbs, states] = status_ranges(&ir.controllers[c]);
+            quote! {
+                bridge.export::<rt::CommandBuffer<#m::Command>>(&rt::command_buffer_name(#m::NAME))?;
+                bridge.import_checked::<rt::StatusBuffer>(
+                    &rt::status_buffer_name(#m::NAME),
+                    #process,
+                    |s: &rt::StatusBuffer| s.check_range(#statuses, #errors, #verbs, #states),
+                )?;
+            }
+        });
+    let operators_expr = &sh.operators;
     quote! {
+        impl Operators {
+            /// The operators of every root, from a process of their own (a
+            /// console, a supervisory program): `config` names process
+            /// `operator` (`BridgeConfig::new(SYSTEM, "operator")`, with the
+            /// `operator` certificate) and connects to the processes that
+            /// run the roots. Each root's command goes to its process, and
+            /// its status comes back, under the operator's access-control
+            /// policy (`config.policy`, when `None`); the root's process
+            /// takes the command through the root's one command writer,
+            /// beside its local operator (`docs/distribution.md`).
+            pub fn remote(
+                mut config: rt::BridgeConfig,
+            ) -> Result<(Self, rt::Bridge), rt::BridgeError> {
+                if config.process != rt::bridge::OPERATOR {
+                    return Err(rt::BridgeError::Identity(format!(
+                        "the operator's bridge is process `{}`, not `{}`",
+                        rt::bridge::OPERATOR, config.process
+                    )));
+                }
+                if config.policy.is_none() {
+                    config.policy = Some(#operator_policy.to_owned());
+                }
+                let gm = rt::GlobalMemory::new();
+                let operators = #operators_expr;
+                let mut bridge = rt::Bridge::builder(config, &gm);
+                #(#remote_roots)*
+                Ok((operators, bridge.start()?))
+            }
+        }
+
         /// The processes of this plan set (the manifest's `process:`), in
         /// the order the schedule names them.
         pub const PROCESSES: [&str; #count] = [#(#processes),*];
@@ -196,6 +259,7 @@ pub(crate) fn process_api(
                 #declare_all
                 #declares
                 let mut executives = Vec::new();
+                let operators = #operators;
                 let bridge = match process {
                     #(#arms)*
                     _ => {
@@ -208,7 +272,7 @@ pub(crate) fn process_api(
                 let system = Self {
                     inputs: Inputs { #(#inputs),* },
                     outputs: #outputs,
-                    operators: #operators,
+                    operators,
                     gm,
                     executives,
                     hooks: ::core::marker::PhantomData,

@@ -18,6 +18,7 @@
 //! watchdog).
 
 use std::sync::atomic::Ordering;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use serde::de::DeserializeOwned;
@@ -32,6 +33,28 @@ use crate::schema::Schema;
 /// verbs and states that the controller has).
 pub type Check<T> = fn(&T) -> Result<(), &'static str>;
 
+/// Where an import writes: the local buffer's own writer, or a root's
+/// command writer shared with the local operator.
+pub(super) enum Sink<T> {
+    Own(Writer<T>),
+    Shared(Arc<Mutex<Writer<T>>>),
+}
+
+impl<T: BufferData> Sink<T> {
+    fn write(&mut self, value: T, cycle: u64) {
+        match self {
+            Sink::Own(w) => {
+                w.write(value, cycle);
+            }
+            Sink::Shared(w) => {
+                w.lock()
+                    .unwrap_or_else(|p| p.into_inner())
+                    .write(value, cycle);
+            }
+        }
+    }
+}
+
 /// The writer instance that owns the buffer now.
 #[derive(Debug, Clone, Copy)]
 struct Owner {
@@ -43,7 +66,9 @@ struct Owner {
 
 /// The import side of one buffer, owned by its subscriber's callback.
 pub(super) struct Import<T> {
-    pub(super) writer: Writer<T>,
+    pub(super) writer: Sink<T>,
+    /// The buffer's name, for refusals.
+    pub(super) name: String,
     /// The process that writes this buffer in the plan set.
     pub(super) expected_writer: String,
     pub(super) check: Check<T>,
@@ -56,7 +81,8 @@ pub(super) struct Import<T> {
 
 impl<T: BufferData + Schema + DeserializeOwned> Import<T> {
     pub(super) fn new(
-        writer: Writer<T>,
+        writer: Sink<T>,
+        name: String,
         expected_writer: String,
         check: Check<T>,
         takeover: Duration,
@@ -64,6 +90,7 @@ impl<T: BufferData + Schema + DeserializeOwned> Import<T> {
     ) -> Self {
         Self {
             writer,
+            name,
             expected_writer,
             check,
             takeover,
@@ -81,7 +108,7 @@ impl<T: BufferData + Schema + DeserializeOwned> Import<T> {
         let max = wire::max_len::<T>();
         let result = if payload.len() > max {
             Err(BridgeError::Oversized {
-                buffer: self.writer.name().to_owned(),
+                buffer: self.name.clone(),
                 len: payload.len(),
                 max,
             })
@@ -89,14 +116,14 @@ impl<T: BufferData + Schema + DeserializeOwned> Import<T> {
             self.apply(&payload.to_bytes(), Instant::now())
         };
         if let Err(e) = result {
-            let buffer = self.writer.name().to_owned();
+            let buffer = self.name.clone();
             self.shared.errors.record(&buffer, e);
         }
     }
 
     /// Check the sample and write it. `Ok` also for a resend dropped.
     fn apply(&mut self, bytes: &[u8], now: Instant) -> Result<(), BridgeError> {
-        let buffer = || self.writer.name().to_owned();
+        let buffer = || self.name.clone();
         let max = wire::max_len::<T>();
         if bytes.len() > max {
             return Err(BridgeError::Oversized {

@@ -63,7 +63,12 @@ pub use error::{BridgeError, BridgeStats, Refusal};
 use error::{Counters, ErrorLog};
 use export::{export_loop, Export, ExportSlot};
 pub use import::Check;
-use import::{any_value, Import};
+use import::{any_value, Import, Sink};
+
+/// The identity (certificate name, and writer name on the wire) of the
+/// operator: a console, or any program commanding the roots from another
+/// process.
+pub const OPERATOR: &str = "operator";
 /// The Zenoh this bridge is built on, for programs that open sessions of
 /// their own beside it (an operator console, tests playing a rogue peer).
 pub use zenoh;
@@ -141,21 +146,51 @@ impl<'a> BridgeBuilder<'a> {
     where
         T: BufferData + Schema + DeserializeOwned + Sync,
     {
-        let local = self.gm.writer::<T>(buffer)?;
+        let local = Sink::Own(self.gm.writer::<T>(buffer)?);
+        self.subscribe(buffer, writer, local, check);
+        Ok(self)
+    }
+
+    /// Take the commands of a remote operator (a process with the identity
+    /// `operator`, such as a console) for root controller `root`, which runs
+    /// in this process and whose local operator is `operator`: both write
+    /// the root's command buffer through its one writer.
+    pub fn import_operator<C>(
+        &mut self,
+        root: &str,
+        operator: &crate::Operator<C>,
+    ) -> Result<&mut Self, BridgeError>
+    where
+        C: crate::handshake::Command + Schema + DeserializeOwned + Sync,
+    {
+        let name = crate::command_buffer_name(root);
+        self.subscribe(
+            &name,
+            OPERATOR,
+            Sink::Shared(operator.shared_writer()),
+            any_value::<crate::CommandBuffer<C>>,
+        );
+        Ok(self)
+    }
+
+    fn subscribe<T>(&mut self, buffer: &str, writer: &str, local: Sink<T>, check: Check<T>)
+    where
+        T: BufferData + Schema + DeserializeOwned + Sync,
+    {
         let key = self.config.key(buffer);
         let expected = writer.to_owned();
+        let name = buffer.to_owned();
         // A restarted writer takes the buffer over once the old instance
         // has missed three resends.
         let takeover = self.config.resend_period.saturating_mul(3);
         self.imports.push(Box::new(move |session, shared| {
-            let mut import = Import::new(local, expected, check, takeover, shared.clone());
+            let mut import = Import::new(local, name, expected, check, takeover, shared.clone());
             session
                 .declare_subscriber(key)
                 .callback_mut(move |sample| import.receive(sample.payload()))
                 .wait()
                 .map_err(|e| BridgeError::Zenoh(e.to_string()))
         }));
-        Ok(self)
     }
 
     /// Open the Zenoh session, declare the subscribers and publishers, and

@@ -160,11 +160,14 @@ pub struct Refusal {
     pub latest: BridgeError,
 }
 
+/// Refusals by `(buffer, kind)`: how many, and the latest.
+type RefusalCounts = BTreeMap<(String, &'static str), (u64, BridgeError)>;
+
 /// Every refusal, counted by buffer and kind. Written by Zenoh's threads,
 /// read by the application: a lock is fine here, it is not the cycle path.
 #[derive(Default)]
 pub(super) struct ErrorLog {
-    pub(super) by_buffer: Mutex<BTreeMap<(String, &'static str), (u64, BridgeError)>>,
+    pub(super) by_buffer: Mutex<RefusalCounts>,
     pub(super) refused: AtomicU64,
 }
 

@@ -183,10 +183,13 @@
 #[cfg(feature = "zenoh")]
 pub mod bridge;
 pub mod driver;
+pub mod epoch;
 pub mod error;
 pub mod exec;
+pub mod fault;
 pub mod gm;
 pub mod handshake;
+pub mod heartbeat;
 pub mod index;
 pub mod math;
 pub mod operator;
@@ -197,11 +200,13 @@ pub mod trace;
 
 #[cfg(feature = "zenoh")]
 pub use bridge::{Bridge, BridgeConfig, BridgeError};
+pub use epoch::fresh_epoch;
 pub use error::SetupError;
 pub use exec::{
     Controller, ControllerStats, CycleContext, Executive, ExecutiveConfig, ExecutiveHandle,
     ExecutiveStats, Heartbeat, Wait,
 };
+pub use fault::{ControllerPanic, CycleFault};
 pub use gm::{
     command_buffer_name, status_buffer_name, status_fields_buffer_name, BufferData, GlobalMemory,
     Reader, Stamped, Writer,

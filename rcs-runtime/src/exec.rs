@@ -441,11 +441,11 @@ impl Executive {
                 slot.last_panic = Some(message.clone());
                 self.fault
                     .get_or_insert_with(|| CycleFault {
-                        executive: self.name.clone(),
                         panics: Vec::new(),
                         total: 0,
                     })
                     .record(ControllerPanic {
+                        executive: self.name.clone(),
                         controller: slot.name.clone(),
                         cycle,
                         message,

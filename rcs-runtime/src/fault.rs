@@ -10,6 +10,8 @@ use std::any::Any;
 /// One caught panic: which controller, in which cycle, with what message.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ControllerPanic {
+    /// The executive it runs on.
+    pub executive: String,
     /// The controller's name.
     pub controller: String,
     /// The executive's cycle count when it panicked.
@@ -23,8 +25,6 @@ pub struct ControllerPanic {
 /// with `HOOK_PANIC`), but the caller should know.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct CycleFault {
-    /// The executive's name.
-    pub executive: String,
     /// The first panics, in the order they happened (at most
     /// [`CycleFault::LISTED`]).
     pub panics: Vec<ControllerPanic>,
@@ -42,19 +42,32 @@ impl CycleFault {
             self.panics.push(panic);
         }
     }
+
+    /// Add `later`'s panics after these (e.g. those of the next executive
+    /// of a system run cycle by cycle), keeping the list's bound.
+    pub fn merge(&mut self, later: CycleFault) {
+        let listed = later.panics.len() as u64;
+        for p in later.panics {
+            if self.panics.len() < Self::LISTED {
+                self.panics.push(p);
+            }
+        }
+        self.total = self
+            .total
+            .saturating_add(later.total.max(listed));
+    }
 }
 
 impl std::fmt::Display for CycleFault {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "executive `{}`: ", self.executive)?;
         for (i, p) in self.panics.iter().enumerate() {
             if i > 0 {
                 f.write_str("; ")?;
             }
             write!(
                 f,
-                "controller `{}` panicked in cycle {}: {}",
-                p.controller, p.cycle, p.message
+                "controller `{}` (executive `{}`) panicked in cycle {}: {}",
+                p.controller, p.executive, p.cycle, p.message
             )?;
         }
         let more = self.total.saturating_sub(self.panics.len() as u64);

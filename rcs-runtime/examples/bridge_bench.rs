@@ -286,7 +286,8 @@ fn heartbeat() {
         let (mut writers, _bridge) = exporting::<Small>(&gm, &ep, with_bridge);
         let mut sink = with_bridge.then(|| child(&["sink", &ep]));
         std::thread::sleep(Duration::from_secs(2));
-        let mut hb = Heartbeat::new(Duration::from_millis(1), Wait::default()).expect("a 1 ms heartbeat");
+        let mut hb =
+            Heartbeat::new(Duration::from_millis(1), Wait::default()).expect("a 1 ms heartbeat");
         let mut late = Vec::with_capacity(5_000);
         for cycle in 0..5_000u64 {
             late.push(hb.wait().as_nanos() as u64);

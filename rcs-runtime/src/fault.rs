@@ -52,9 +52,7 @@ impl CycleFault {
                 self.panics.push(p);
             }
         }
-        self.total = self
-            .total
-            .saturating_add(later.total.max(listed));
+        self.total = self.total.saturating_add(later.total.max(listed));
     }
 }
 

@@ -114,9 +114,15 @@ fn a_panicking_hook_ends_its_plan_with_hook_panic_and_the_others_run_on() {
         (pr_status.value.status, pr_status.value.error),
         (Status::ERROR, ErrorCode::HOOK_PANIC)
     );
-    assert_eq!(pr::Error::from_raw(pr_status.value.error), Some(pr::Error::HookPanic));
+    assert_eq!(
+        pr::Error::from_raw(pr_status.value.error),
+        Some(pr::Error::HookPanic)
+    );
     assert_eq!(pr::Error::HookPanic.name(), "HOOK_PANIC");
-    assert_eq!(system.pr().and_then(pr::Controller::status), Some(pr::Status::Error));
+    assert_eq!(
+        system.pr().and_then(pr::Controller::status),
+        Some(pr::Status::Error)
+    );
     assert_eq!(
         system.sm().map(|c| c.bookkeeping().error()),
         Some(sm::error::SUBORDINATE_FAILED)

@@ -135,7 +135,7 @@
 //!     }
 //! }
 //!
-//! # fn main() -> Result<(), rcs_runtime::SetupError> {
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! // Setup: Global Memory, handles, the executive. Allocation is fine here.
 //! let gm = GlobalMemory::new();
 //! gm.declare_controller::<TbCommand>("TB")?;
@@ -158,13 +158,13 @@
 //!
 //! // Run: command, cycle, watch the status through the handshake.
 //! operator.command(TbCommand::Spin { rpm: 100.0 });
-//! cpu.step();
+//! cpu.step()?;
 //! assert_eq!(operator.view().status, Status::EXECUTING);
 //! sensor.write(99.5, 1);
-//! cpu.step();
+//! cpu.step()?;
 //! assert_eq!(operator.view().status, AT_SPEED);
 //! sensor.write(250.0, 2);
-//! cpu.step();
+//! cpu.step()?;
 //! assert_eq!(operator.outcome(), Some((Status::ERROR, OVERSPEED)));
 //! assert_eq!(cpu.cycle(), 3);
 //! # Ok(())

@@ -144,7 +144,9 @@ fn a_panicking_controller_is_contained_and_reported() -> Result<(), SetupError> 
     );
     assert_eq!(fault.panics[0].message, "hook BAD failed");
     assert!(
-        fault.to_string().contains("`BAD` panicked in cycle 0"),
+        fault.to_string().starts_with(
+            "controller `BAD` (executive `cpu`) panicked in cycle 0: hook BAD failed;"
+        ),
         "{fault}"
     );
     // The others ran every cycle, after the panic too.

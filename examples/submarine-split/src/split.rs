@@ -425,3 +425,6 @@ fn statuses_of_helm(system: &Sub) -> String {
         .collect::<Vec<_>>()
         .join(" ")
 }
+
+#[cfg(test)]
+mod restart_tests;

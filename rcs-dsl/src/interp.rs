@@ -95,6 +95,9 @@ pub struct Interpreter<'ir> {
     cycle: u64,
     /// The supervisor's command buffer: serial, verb, parameters.
     command: (u32, CommandId, Vec<Value>),
+    /// The supervisor's side of the handshake: allocates the serial and
+    /// epoch of each command (the epoch is the link's, as in generated code).
+    supervisor: SubordinateLink,
     /// The parameters of the command being executed.
     active_params: Vec<Value>,
     vars: Vec<Value>,
@@ -117,6 +120,7 @@ impl<'ir> Interpreter<'ir> {
             bk: Bookkeeping::new(c.commands.len()),
             cycle: 0,
             command: (0, CommandId(0), Vec::new()),
+            supervisor: SubordinateLink::new(),
             active_params: Vec::new(),
             vars: Vec::new(),
             reads: c
@@ -157,9 +161,10 @@ impl<'ir> Interpreter<'ir> {
         self.ctrl
     }
 
-    /// The supervisor writes a new command (the next serial).
+    /// The supervisor writes a new command (the next serial, in the
+    /// supervisor's epoch).
     pub fn command(&mut self, command: CommandId, params: Vec<Value>) -> u32 {
-        let serial = rcs_runtime::next_serial(self.command.0);
+        let serial = self.supervisor.next_command();
         self.command = (serial, command, params);
         serial
     }
@@ -192,6 +197,13 @@ impl<'ir> Interpreter<'ir> {
         self.subs[index].link.last_sent()
     }
 
+    /// The epoch of the commands this controller sends a subordinate (0:
+    /// none sent yet): a status answers a command only when it echoes both
+    /// its serial and this.
+    pub fn sent_epoch(&self, index: usize) -> u32 {
+        self.subs[index].link.epoch()
+    }
+
     pub fn bookkeeping(&self) -> &Bookkeeping {
         &self.bk
     }
@@ -217,8 +229,13 @@ impl<'ir> Interpreter<'ir> {
             .commands
             .get(verb.index())
             .is_some_and(|c| c.plan.is_some());
-        self.bk
-            .begin_cycle_raw(Tick::now(self.cycle), serial, verb.0 as u16, has_plan);
+        self.bk.begin_cycle_raw(
+            Tick::now(self.cycle),
+            serial,
+            self.supervisor.epoch(),
+            verb.0 as u16,
+            has_plan,
+        );
         if self.bk.new_command() {
             self.active_params = params;
         }

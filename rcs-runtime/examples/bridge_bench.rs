@@ -250,7 +250,7 @@ fn run_load<T: rcs_runtime::BufferData + Schema + Serialize + Sync>(size: usize)
     std::thread::sleep(Duration::from_secs(2));
     let (t0, p0) = (thread_cpu_ticks("rcs-bridge-pub"), process_cpu_ticks());
     let start = Instant::now();
-    let mut hb = Heartbeat::new(Duration::from_millis(1), Wait::Sleep);
+    let mut hb = Heartbeat::new(Duration::from_millis(1), Wait::Sleep).expect("a 1 ms heartbeat");
     let mut cycle = 0;
     while start.elapsed() < Duration::from_secs(5) {
         hb.wait();
@@ -286,7 +286,8 @@ fn heartbeat() {
         let (mut writers, _bridge) = exporting::<Small>(&gm, &ep, with_bridge);
         let mut sink = with_bridge.then(|| child(&["sink", &ep]));
         std::thread::sleep(Duration::from_secs(2));
-        let mut hb = Heartbeat::new(Duration::from_millis(1), Wait::default());
+        let mut hb =
+            Heartbeat::new(Duration::from_millis(1), Wait::default()).expect("a 1 ms heartbeat");
         let mut late = Vec::with_capacity(5_000);
         for cycle in 0..5_000u64 {
             late.push(hb.wait().as_nanos() as u64);

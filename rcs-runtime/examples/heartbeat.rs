@@ -6,7 +6,7 @@
 
 use std::time::Duration;
 
-use rcs_runtime::{Heartbeat, Wait};
+use rcs_runtime::{Heartbeat, SetupError, Wait};
 
 fn percentile(sorted: &[u64], p: f64) -> u64 {
     if sorted.is_empty() {
@@ -16,15 +16,15 @@ fn percentile(sorted: &[u64], p: f64) -> u64 {
     sorted[i.min(sorted.len() - 1)]
 }
 
-fn measure(period: Duration, wait: Wait, cycles: usize) -> Vec<u64> {
-    let mut hb = Heartbeat::new(period, wait);
+fn measure(period: Duration, wait: Wait, cycles: usize) -> Result<Vec<u64>, SetupError> {
+    let mut hb = Heartbeat::new(period, wait)?;
     hb.start(std::time::Instant::now());
     let mut late: Vec<u64> = (0..cycles).map(|_| hb.wait().as_nanos() as u64).collect();
     late.sort_unstable();
-    late
+    Ok(late)
 }
 
-fn main() {
+fn main() -> Result<(), SetupError> {
     let mut args = std::env::args().skip(1);
     let cycles: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(2000);
     let period_us: u64 = args.next().and_then(|a| a.parse().ok()).unwrap_or(1000);
@@ -45,7 +45,7 @@ fn main() {
             Wait::SleepSpin(Duration::from_micros(200)),
         ),
     ] {
-        let late = measure(period, wait, cycles);
+        let late = measure(period, wait, cycles)?;
         let us = |ns: u64| ns as f64 / 1000.0;
         println!(
             "{:<22} {:>10.1} {:>10.1} {:>10.1}",
@@ -55,4 +55,5 @@ fn main() {
             us(*late.last().unwrap_or(&0)),
         );
     }
+    Ok(())
 }

@@ -324,7 +324,10 @@ pub trait Driven {
     fn set_write(&mut self, buffer: &str, value: &Value) -> Result<(), DriveError>;
     /// Subordinate `sub` writes its status buffer (a new generation) before
     /// the next cycle. A subordinate not written is silent: its status
-    /// goes stale.
+    /// goes stale. An `echo_epoch` of 0 stands for the epoch of this
+    /// controller's commands to `sub`, which the driver fills in: scenarios
+    /// name serials only (the epoch is a detail of the handshake); a
+    /// nonzero epoch is written as given.
     fn write_sub_status(&mut self, sub: &str, status: StatusBuffer) -> Result<(), DriveError>;
     /// The serial of the last command this controller sent `sub` (0: none).
     fn last_sent(&mut self, sub: &str) -> Result<u32, DriveError>;

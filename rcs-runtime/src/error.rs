@@ -32,4 +32,8 @@ pub enum SetupError {
     /// An executive period longer than [`MAX_PERIOD`](crate::exec::MAX_PERIOD).
     #[error("executive `{0}` has a period of {1:?}; the longest accepted is one hour")]
     PeriodTooLong(String, std::time::Duration),
+    /// A heartbeat period of zero (every nanosecond would be a missed
+    /// heartbeat) or above [`MAX_PERIOD`](crate::exec::MAX_PERIOD).
+    #[error("a heartbeat period must be more than zero and at most one hour, not {0:?}")]
+    HeartbeatPeriod(std::time::Duration),
 }

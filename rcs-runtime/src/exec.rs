@@ -13,17 +13,31 @@
 //! one [`GlobalMemory`](crate::GlobalMemory); the handshake keeps them
 //! correct without synchronising their cycles (§5.5).
 //!
+//! A controller whose cycle panics (a hand-written hook, say) is contained:
+//! each cycle runs inside [`std::panic::catch_unwind`], the faulty
+//! controller is told through [`Controller::fault`] (generated controllers
+//! end their plan with the built-in error `HOOK_PANIC` and publish their
+//! status), the panic is counted ([`ControllerStats::panics`],
+//! [`Executive::last_panic`]) and the other controllers run on.
+//! [`Executive::step`] and [`Executive::run_cycles`] report the panics as a
+//! [`CycleFault`]; on the heartbeat ([`Executive::run`]) the statistics keep
+//! them.
+//!
 //! Nothing here allocates or locks once the controllers are added, unless a
-//! trace sink is attached ([`Executive::set_trace`]).
+//! trace sink is attached ([`Executive::set_trace`]) or a controller panics.
 
 use std::any::Any;
 use std::io;
+use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use crate::error::SetupError;
+use crate::fault::{panic_message, ControllerPanic, CycleFault};
+use crate::handshake::ErrorCode;
+pub use crate::heartbeat::{Heartbeat, Wait, MAX_PERIOD};
 use crate::plan::{Bookkeeping, SampleStats, Tick};
 use crate::trace::{TraceRecord, TraceSink};
 
@@ -67,116 +81,22 @@ pub trait Controller: Any + Send {
         None
     }
 
+    /// The executive caught a panic out of [`cycle`](Self::cycle) (a
+    /// hand-written hook, say): end the running plan with `code`
+    /// ([`ErrorCode::HOOK_PANIC`]) and publish the status as step 5 would,
+    /// so that the supervisor sees ERROR instead of a status frozen at
+    /// EXECUTING. The next command must start normally. The default does
+    /// nothing (a controller without plans).
+    fn fault(&mut self, code: ErrorCode, ctx: &CycleContext) {
+        let _ = (code, ctx);
+    }
+
     /// Each subordinate's name with the cycles in which it answered with an
     /// older serial than the last command sent
     /// ([`SubordinateLink::old_echoes`](crate::SubordinateLink::old_echoes)),
     /// given to `f` one by one. For the timing report, not the cycle path.
     fn old_echoes(&self, f: &mut dyn FnMut(&str, u64)) {
         let _ = f;
-    }
-}
-
-/// How the executive waits for the next deadline.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Wait {
-    /// Sleep until the deadline (the OS decides how late it wakes up).
-    Sleep,
-    /// Sleep until `spin` before the deadline, then spin on the clock.
-    SleepSpin(Duration),
-    /// Spin on the clock the whole time (burns the core).
-    Spin,
-}
-
-impl Default for Wait {
-    fn default() -> Self {
-        Wait::SleepSpin(Duration::from_micros(200))
-    }
-}
-
-/// The longest heartbeat period an executive accepts: an hour. Deadlines
-/// are instants `start + k × period`; a bound keeps that arithmetic far from
-/// overflow however long the system runs, and no RCS level plans slower.
-pub const MAX_PERIOD: Duration = Duration::from_secs(3600);
-
-/// A periodic clock with absolute deadlines: deadline `k` is `start + k ×
-/// period`, so lateness does not accumulate. Deadlines that have already
-/// passed when a wait begins are *missed*: they are skipped (counted in
-/// [`missed`](Self::missed)), and the schedule restarts from now.
-#[derive(Debug, Clone)]
-pub struct Heartbeat {
-    period: Duration,
-    wait: Wait,
-    next: Option<Instant>,
-    missed: u64,
-}
-
-impl Heartbeat {
-    /// A heartbeat of `period` (at most [`MAX_PERIOD`]; a longer one is cut
-    /// to it), waiting with `wait`.
-    pub fn new(period: Duration, wait: Wait) -> Self {
-        Self {
-            period: period.min(MAX_PERIOD),
-            wait,
-            next: None,
-            missed: 0,
-        }
-    }
-
-    /// Deadlines skipped so far because a cycle (or the machine) ran past
-    /// them: a cycle that overran by three periods misses two heartbeats.
-    pub fn missed(&self) -> u64 {
-        self.missed
-    }
-
-    /// Start the schedule: the first deadline is one period after `now`.
-    pub fn start(&mut self, now: Instant) {
-        self.next = Some(now + self.period);
-    }
-
-    /// Wait for the next deadline and return how late it woke (zero or
-    /// more). Starts the schedule if [`start`](Self::start) was not called.
-    pub fn wait(&mut self) -> Duration {
-        let deadline = match self.next {
-            Some(d) => d,
-            None => {
-                let d = Instant::now() + self.period;
-                self.next = Some(d);
-                d
-            }
-        };
-        let spin = match self.wait {
-            Wait::Sleep => Duration::ZERO,
-            Wait::SleepSpin(s) => s,
-            Wait::Spin => self.period,
-        };
-        let now = Instant::now();
-        if let Some(left) = deadline.checked_duration_since(now) {
-            if left > spin {
-                std::thread::sleep(left - spin);
-            }
-        }
-        let mut woke = Instant::now();
-        while woke < deadline {
-            std::hint::spin_loop();
-            woke = Instant::now();
-        }
-        let mut next = deadline + self.period;
-        if next <= woke {
-            // Every deadline in (deadline, woke] was missed.
-            let behind = woke.saturating_duration_since(deadline).as_nanos();
-            let missed = behind / self.period.as_nanos().max(1);
-            self.missed = self
-                .missed
-                .saturating_add(u64::try_from(missed).unwrap_or(u64::MAX));
-            next = woke + self.period;
-        }
-        self.next = Some(next);
-        woke.saturating_duration_since(deadline)
-    }
-
-    /// The period.
-    pub fn period(&self) -> Duration {
-        self.period
     }
 }
 
@@ -188,6 +108,9 @@ pub struct ControllerStats {
     pub exec_ns: SampleStats,
     /// Cycles in which this controller alone took longer than the period.
     pub overruns: u64,
+    /// Cycles in which this controller panicked (the executive caught the
+    /// panic and ended its plan with `HOOK_PANIC`).
+    pub panics: u64,
 }
 
 /// Statistics of an executive.
@@ -316,6 +239,7 @@ struct Slot {
     name: String,
     ctrl: Box<dyn Controller>,
     stats: ControllerStats,
+    last_panic: Option<String>,
 }
 
 /// The main program of one CPU. See the module docs.
@@ -330,6 +254,8 @@ pub struct Executive {
     stats: ExecutiveStats,
     shared: Arc<Shared>,
     trace: Option<TraceSink>,
+    /// Panics caught since the last `step`/`run_cycles` reported them.
+    fault: Option<CycleFault>,
 }
 
 impl std::fmt::Debug for Executive {
@@ -357,7 +283,7 @@ impl Executive {
             return Err(SetupError::PeriodTooLong(config.name, config.period));
         }
         Ok(Self {
-            heartbeat: Heartbeat::new(config.period, config.wait),
+            heartbeat: Heartbeat::new(config.period, config.wait)?,
             period_ns: nanos(config.period),
             period: config.period,
             measure: config.measure,
@@ -367,6 +293,7 @@ impl Executive {
             stats: ExecutiveStats::default(),
             shared: Arc::default(),
             trace: None,
+            fault: None,
         })
     }
 
@@ -380,6 +307,7 @@ impl Executive {
             name,
             ctrl,
             stats: ControllerStats::default(),
+            last_panic: None,
         });
         Ok(())
     }
@@ -405,15 +333,27 @@ impl Executive {
     }
 
     /// Run exactly one cycle now, without waiting (single step for tests and
-    /// simulation; ignores pause).
-    pub fn step(&mut self) {
+    /// simulation; ignores pause). A controller that panicked was contained
+    /// (see the module docs) and is reported in the error.
+    pub fn step(&mut self) -> Result<(), CycleFault> {
         self.run_one();
+        self.take_fault()
     }
 
     /// Run `n` cycles back to back, as fast as possible (ignores pause).
-    pub fn run_cycles(&mut self, n: u64) {
+    /// All `n` cycles run even if controllers panic; the panics are
+    /// reported in the error.
+    pub fn run_cycles(&mut self, n: u64) -> Result<(), CycleFault> {
         for _ in 0..n {
             self.run_one();
+        }
+        self.take_fault()
+    }
+
+    fn take_fault(&mut self) -> Result<(), CycleFault> {
+        match self.fault.take() {
+            None => Ok(()),
+            Some(f) => Err(f),
         }
     }
 
@@ -451,6 +391,9 @@ impl Executive {
                     .is_ok();
             if !paused || stepping {
                 self.run_one();
+                // On the heartbeat, panics live on in the statistics
+                // (`panics`, `last_panic`) rather than piling up here.
+                self.fault = None;
             }
             let late = self.heartbeat.wait();
             self.stats.lateness_ns.record(nanos(late));
@@ -486,7 +429,28 @@ impl Executive {
                 now: t0,
                 period,
             };
-            slot.ctrl.cycle(&ctx);
+            // No allocation unless a panic happens.
+            if let Err(payload) = catch_unwind(AssertUnwindSafe(|| slot.ctrl.cycle(&ctx))) {
+                let message = panic_message(payload.as_ref());
+                // The fault handler is contained too: a controller that
+                // cannot even fault must not take the others down.
+                let _ = catch_unwind(AssertUnwindSafe(|| {
+                    slot.ctrl.fault(ErrorCode::HOOK_PANIC, &ctx)
+                }));
+                slot.stats.panics = slot.stats.panics.saturating_add(1);
+                slot.last_panic = Some(message.clone());
+                self.fault
+                    .get_or_insert_with(|| CycleFault {
+                        panics: Vec::new(),
+                        total: 0,
+                    })
+                    .record(ControllerPanic {
+                        executive: self.name.clone(),
+                        controller: slot.name.clone(),
+                        cycle,
+                        message,
+                    });
+            }
             if self.measure {
                 let t1 = Instant::now();
                 let ns = nanos(t1.saturating_duration_since(t0));
@@ -553,6 +517,22 @@ impl Executive {
     pub fn controller_stats(&self, name: &str) -> Option<&ControllerStats> {
         self.slots.iter().find(|s| s.name == name).map(|s| &s.stats)
     }
+    /// The message of the last panic caught in controller `name`'s cycle
+    /// (`None`: it never panicked, or there is no such controller).
+    pub fn last_panic(&self, name: &str) -> Option<&str> {
+        self.slots
+            .iter()
+            .find(|s| s.name == name)
+            .and_then(|s| s.last_panic.as_deref())
+    }
+    /// Commands overwritten in controller `name`'s command buffer before it
+    /// read them ([`Bookkeeping::commands_lost`]; 0 for a controller
+    /// without bookkeeping, or one not on this executive).
+    pub fn commands_lost(&self, name: &str) -> u64 {
+        self.controller(name)
+            .and_then(|c| c.bookkeeping())
+            .map_or(0, Bookkeeping::commands_lost)
+    }
     /// Per subordinate of controller `name`, the cycles in which it echoed
     /// an older serial than the last command sent (empty for a controller
     /// without subordinates, or one not on this executive).
@@ -586,152 +566,4 @@ impl Executive {
 }
 
 #[cfg(test)]
-mod tests {
-    /// A supervisor with one subordinate that keeps echoing an old serial.
-    struct Stuck {
-        link: crate::SubordinateLink,
-    }
-
-    impl Controller for Stuck {
-        fn name(&self) -> &str {
-            "SUP"
-        }
-        fn cycle(&mut self, ctx: &CycleContext) {
-            let read = crate::gm::Stamped {
-                value: crate::StatusBuffer::default(),
-                generation: ctx.cycle + 1,
-                writer_cycle: ctx.cycle,
-            };
-            self.link.observe(&read);
-        }
-        fn old_echoes(&self, f: &mut dyn FnMut(&str, u64)) {
-            f("SUB", self.link.old_echoes());
-        }
-    }
-
-    #[test]
-    fn the_timing_report_gives_each_subordinates_old_echoes() -> Result<(), SetupError> {
-        let mut link = crate::SubordinateLink::new();
-        link.next_command();
-        let mut e = Executive::new(ExecutiveConfig::new("cpu", Duration::from_millis(1)))?;
-        e.add(Box::new(Stuck { link }))?;
-        e.run_cycles(5);
-        assert_eq!(e.old_echoes("SUP"), vec![("SUB".to_string(), 5)]);
-        assert!(e.old_echoes("NOBODY").is_empty());
-        Ok(())
-    }
-
-    #[test]
-    fn a_period_past_the_bound_is_refused_at_construction() {
-        let e = Executive::new(ExecutiveConfig::new("cpu", Duration::MAX));
-        assert!(matches!(e, Err(SetupError::PeriodTooLong(..))), "{e:?}");
-        assert!(Executive::new(ExecutiveConfig::new("cpu", MAX_PERIOD)).is_ok());
-        // A heartbeat built directly is cut to the bound, not left to overflow.
-        assert_eq!(
-            Heartbeat::new(Duration::MAX, Wait::Sleep).period(),
-            MAX_PERIOD
-        );
-    }
-
-    #[test]
-    fn deadlines_already_past_are_counted_as_missed() {
-        // Started 50 ms ago with a 1 ms period: the first deadline is 49 ms
-        // past when the wait begins, and every deadline up to now is missed.
-        let period = Duration::from_millis(1);
-        let mut hb = Heartbeat::new(period, Wait::Sleep);
-        let Some(start) = Instant::now().checked_sub(Duration::from_millis(50)) else {
-            return;
-        };
-        hb.start(start);
-        hb.wait();
-        assert!(hb.missed() >= 48, "missed {}", hb.missed());
-    }
-
-    use super::*;
-
-    #[test]
-    fn heartbeat_deadlines_are_absolute() {
-        for wait in [Wait::Sleep, Wait::default(), Wait::Spin] {
-            let period = Duration::from_millis(2);
-            let mut hb = Heartbeat::new(period, wait);
-            let start = Instant::now();
-            hb.start(start);
-            for _ in 0..10 {
-                let _late = hb.wait();
-            }
-            // Never early: the 10th deadline is 10 periods after the start.
-            assert!(start.elapsed() >= period * 10, "{wait:?}");
-            assert_eq!(hb.period(), period);
-        }
-    }
-
-    #[test]
-    fn heartbeat_skips_missed_deadlines() {
-        let period = Duration::from_millis(1);
-        let mut hb = Heartbeat::new(period, Wait::Sleep);
-        let start = Instant::now();
-        hb.start(start);
-        std::thread::sleep(Duration::from_millis(5));
-        let late = hb.wait();
-        let after = Instant::now();
-        assert!(late >= Duration::from_millis(3));
-        // The schedule restarted from the wake-up, one period on: not the
-        // missed deadlines (start + 2 ms, + 3 ms, …) to catch up on. Checked
-        // on the schedule itself, not on how long a wait took.
-        let next = hb.next.expect("started");
-        assert!(
-            next > start + Duration::from_millis(5),
-            "{:?}",
-            next - start
-        );
-        assert!(next <= after + period, "{:?}", next - start);
-    }
-
-    #[test]
-    fn cycle_context_tick() {
-        let now = Instant::now();
-        let ctx = CycleContext {
-            cycle: 4,
-            now,
-            period: Duration::from_millis(1),
-        };
-        assert_eq!(ctx.tick(), Tick { cycle: 4, now });
-    }
-
-    struct Counter(u64);
-    impl Controller for Counter {
-        fn name(&self) -> &str {
-            "count"
-        }
-        fn cycle(&mut self, _: &CycleContext) {
-            self.0 += 1;
-        }
-    }
-    struct Other;
-    impl Controller for Other {
-        fn name(&self) -> &str {
-            "other"
-        }
-        fn cycle(&mut self, _: &CycleContext) {}
-    }
-
-    #[test]
-    fn a_controller_comes_back_as_its_own_type() -> Result<(), SetupError> {
-        let mut exec = Executive::new(ExecutiveConfig::new("x", Duration::from_millis(1)))?;
-        exec.add(Box::new(Counter(0)))?;
-        exec.add(Box::new(Other))?;
-        exec.run_cycles(3);
-        assert_eq!(exec.controller_as::<Counter>("count").map(|c| c.0), Some(3));
-        assert!(exec.controller_as::<Other>("count").is_none());
-        assert!(exec.controller_as::<Counter>("nobody").is_none());
-        if let Some(c) = exec.controller_as_mut::<Counter>("count") {
-            c.0 = 10;
-        }
-        exec.step();
-        assert_eq!(
-            exec.controller_as::<Counter>("count").map(|c| c.0),
-            Some(11)
-        );
-        Ok(())
-    }
-}
+mod tests;

@@ -2,10 +2,12 @@
 //! (§5.5 of the methodology; docs/semantics.md "Global Memory and its buffers" and step 2).
 //!
 //! A supervisor commands a subordinate by writing its command buffer with a
-//! fresh serial number; the subordinate echoes the serial of the command it
-//! works on in its status buffer. The supervisor trusts a status only when
-//! the echo matches the serial it last sent: otherwise the subordinate has not
-//! picked the command up yet, and the supervisor sees EXECUTING. The
+//! fresh serial number and its link's epoch ([`crate::epoch`]); the
+//! subordinate echoes both of the command it works on in its status buffer.
+//! The supervisor trusts a status only when serial and epoch both match the
+//! ones it last sent: otherwise the subordinate has not picked the command up
+//! yet (or answers a command of an earlier incarnation of the supervisor, or
+//! of the serials before a wrap), and the supervisor sees EXECUTING. The
 //! generation stamps of Global Memory give the watchdog count
 //! `stale_cycles`.
 //!
@@ -15,6 +17,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::epoch::fresh_epoch;
 use crate::gm::{GlobalMemory, Reader, Stamped, Writer};
 use crate::seqlock::Staged;
 use crate::SetupError;
@@ -68,7 +71,7 @@ impl Status {
 
 /// An error code: 0 is "no error", 1 is the runtime's `UNKNOWN_COMMAND`,
 /// error codes declared by a controller follow from 2; `u16::MAX` is the
-/// runtime's `INDEX_RANGE`.
+/// runtime's `INDEX_RANGE` and `u16::MAX - 1` its `HOOK_PANIC`.
 #[derive(
     Debug, Clone, Copy, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
 )]
@@ -85,6 +88,12 @@ impl ErrorCode {
     /// declared errors (from [`FIRST_CUSTOM`](Self::FIRST_CUSTOM)) keep
     /// their numbers.
     pub const INDEX_RANGE: ErrorCode = ErrorCode(u16::MAX);
+    /// A hook (or anything else in the controller's cycle) panicked: the
+    /// executive caught the panic and ended the plan with this built-in
+    /// error ([`Controller::fault`](crate::Controller::fault)). Next to
+    /// [`INDEX_RANGE`](Self::INDEX_RANGE) at the top, so that declared
+    /// codes keep their numbers.
+    pub const HOOK_PANIC: ErrorCode = ErrorCode(u16::MAX - 1);
     /// The code of the first declared error.
     pub const FIRST_CUSTOM: u16 = 2;
 
@@ -101,7 +110,9 @@ impl ErrorCode {
     /// Whether this is one of the runtime's built-in error codes (which
     /// any controller can end with, whatever it declares).
     pub const fn is_builtin(self) -> bool {
-        self.0 == Self::UNKNOWN_COMMAND.0 || self.0 == Self::INDEX_RANGE.0
+        self.0 == Self::UNKNOWN_COMMAND.0
+            || self.0 == Self::INDEX_RANGE.0
+            || self.0 == Self::HOOK_PANIC.0
     }
 }
 
@@ -121,12 +132,15 @@ impl Command for VerbId {
     }
 }
 
-/// A controller's command buffer: `{serial, verb, params}`, with verb and
-/// parameters in `command`. Serial 0 means "no command yet".
+/// A controller's command buffer: `{serial, epoch, verb, params}`, with verb
+/// and parameters in `command`. Serial 0 means "no command yet".
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct CommandBuffer<C> {
-    /// Serial number of this command; a new serial is a new command.
+    /// Serial number of this command; a new serial (or epoch) is a new command.
     pub serial: u32,
+    /// The sending link's epoch ([`crate::epoch`]): with the serial, the
+    /// command's identity across supervisor restarts and serial wrap-around.
+    pub epoch: u32,
     /// The verb and its parameters.
     pub command: C,
 }
@@ -139,11 +153,13 @@ impl<C: Command> CommandBuffer<C> {
 }
 
 /// A controller's status buffer, plain data. All zeros before the first
-/// write: `{echo_serial: 0, NOT_READY, no error}`.
+/// write: `{echo_serial: 0, echo_epoch: 0, NOT_READY, no error}`.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct StatusBuffer {
     /// Serial of the command this status is about.
     pub echo_serial: u32,
+    /// Epoch of the command this status is about.
+    pub echo_epoch: u32,
     /// The status.
     pub status: Status,
     /// The error code when `status` is ERROR, else NONE.
@@ -225,12 +241,14 @@ impl SubordinateView {
     }
 }
 
-/// A supervisor's bookkeeping for one subordinate: the serial it last sent,
-/// the last status generation it saw and the resulting view. Works on plain
-/// values, so it serves generated code and interpreters alike.
+/// A supervisor's bookkeeping for one subordinate: the serial and epoch it
+/// last sent, the last status generation it saw and the resulting view.
+/// Works on plain values, so it serves generated code and interpreters alike.
 #[derive(Debug, Clone, Copy)]
 pub struct SubordinateLink {
     last_sent: u32,
+    /// The epoch of the commands sent (0: not drawn yet).
+    epoch: u32,
     seen_generation: u64,
     view: SubordinateView,
     old_echoes: u64,
@@ -243,10 +261,25 @@ impl Default for SubordinateLink {
 }
 
 impl SubordinateLink {
-    /// A link that has sent nothing yet.
+    /// A link that has sent nothing yet; its epoch is drawn
+    /// ([`fresh_epoch`]) when it sends its first command.
     pub const fn new() -> Self {
+        Self::with_epoch(0)
+    }
+
+    /// A link that has sent nothing yet, with its epoch drawn now (keeps the
+    /// first draw of the process off the cycle path).
+    pub fn fresh() -> Self {
+        Self::with_epoch(fresh_epoch())
+    }
+
+    /// A link whose commands carry `epoch` (0: draw one at the first
+    /// command) until its serials wrap. For tests, and for whoever keeps
+    /// epochs itself.
+    pub const fn with_epoch(epoch: u32) -> Self {
         Self {
             last_sent: 0,
+            epoch,
             seen_generation: 0,
             view: SubordinateView {
                 status: Status::NOT_READY,
@@ -254,6 +287,7 @@ impl SubordinateLink {
                 stale_cycles: 0,
                 raw: StatusBuffer {
                     echo_serial: 0,
+                    echo_epoch: 0,
                     status: Status::NOT_READY,
                     error: ErrorCode::NONE,
                     verb: 0,
@@ -280,10 +314,14 @@ impl SubordinateLink {
             self.view.stale_cycles.saturating_add(1)
         };
         let raw = read.value;
-        let (status, error) = if raw.echo_serial == self.last_sent {
+        // Nothing sent: only "no command" (serial 0, whatever epoch) is ours.
+        let ours = raw.echo_serial == self.last_sent
+            && (self.last_sent == 0 || raw.echo_epoch == self.epoch);
+        let (status, error) = if ours {
             (raw.status, raw.error)
         } else {
-            // A status for an older command never counts for the newer one.
+            // A status for an older command (of this incarnation, an earlier
+            // one, or before a wrap) never counts for the newer one.
             self.old_echoes = self.old_echoes.saturating_add(1);
             (Status::EXECUTING, ErrorCode::NONE)
         };
@@ -320,12 +358,32 @@ impl SubordinateLink {
     }
 
     /// Allocate the serial of a new command to this subordinate and remember
-    /// it as the last one sent. The view of this cycle is not changed (the
-    /// conditions of a cycle are evaluated before its jobs run).
+    /// it as the last one sent; send it with [`epoch`](Self::epoch). When
+    /// the serials wrap (`u32::MAX` → 1) the link takes a fresh epoch, so a
+    /// wrapped serial never names an older command. The view of this cycle
+    /// is not changed (the conditions of a cycle are evaluated before its
+    /// jobs run).
     #[inline]
     pub fn next_command(&mut self) -> u32 {
-        self.last_sent = next_serial(self.last_sent);
-        self.last_sent
+        let serial = next_serial(self.last_sent);
+        if self.epoch == 0 || serial < self.last_sent {
+            self.epoch = fresh_epoch();
+        }
+        self.last_sent = serial;
+        serial
+    }
+
+    /// The epoch of the commands this link sends (0: none drawn yet).
+    #[inline]
+    pub fn epoch(&self) -> u32 {
+        self.epoch
+    }
+
+    /// The identity of the last command sent as a subordinate echoes it:
+    /// a status buffer with this serial and epoch answers it.
+    #[inline]
+    pub fn echo_of_last(&self) -> (u32, u32) {
+        (self.last_sent, self.epoch)
     }
 
     /// The serial of the last command sent (0: none).
@@ -334,8 +392,8 @@ impl SubordinateLink {
         self.last_sent
     }
 
-    /// Start the serials after `serial` (e.g. to resume after a restart, or
-    /// to test wrap-around).
+    /// Start the serials after `serial` (e.g. to test wrap-around). The
+    /// epoch stays; the next command after `u32::MAX` takes a fresh one.
     pub fn set_last_sent(&mut self, serial: u32) {
         self.last_sent = serial;
     }
@@ -364,7 +422,7 @@ impl<C: Command> Subordinate<C> {
     pub fn connect(gm: &GlobalMemory, ctrl: &str) -> Result<Self, SetupError> {
         gm.declare_controller::<C>(ctrl)?;
         Ok(Self {
-            link: SubordinateLink::new(),
+            link: SubordinateLink::fresh(),
             status: gm.status_reader(ctrl)?,
             command: gm.command_writer::<C>(ctrl)?,
             out: Staged::new(CommandBuffer::default()),
@@ -390,7 +448,12 @@ impl<C: Command> Subordinate<C> {
     #[inline]
     pub fn send(&mut self, command: C) -> u32 {
         let serial = self.link.next_command();
-        self.out.set(CommandBuffer { serial, command });
+        let epoch = self.link.epoch();
+        self.out.set(CommandBuffer {
+            serial,
+            epoch,
+            command,
+        });
         self.dirty = true;
         serial
     }
@@ -425,181 +488,4 @@ impl<C: Command> Subordinate<C> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn stamped(echo: u32, status: Status, generation: u64) -> Stamped<StatusBuffer> {
-        Stamped {
-            value: StatusBuffer {
-                echo_serial: echo,
-                status,
-                error: if status == Status::ERROR {
-                    ErrorCode::custom(0)
-                } else {
-                    ErrorCode::NONE
-                },
-                verb: 0,
-                state: 0,
-            },
-            generation,
-            writer_cycle: generation,
-        }
-    }
-
-    #[test]
-    fn serials_wrap_to_one_never_zero() {
-        assert_eq!(next_serial(0), 1);
-        assert_eq!(next_serial(41), 42);
-        assert_eq!(next_serial(u32::MAX - 1), u32::MAX);
-        assert_eq!(next_serial(u32::MAX), 1);
-        let mut l = SubordinateLink::new();
-        l.set_last_sent(u32::MAX);
-        assert_eq!(l.next_command(), 1);
-        assert_eq!(l.last_sent(), 1);
-    }
-
-    #[test]
-    fn zeroed_buffers_read_not_ready() {
-        let s = StatusBuffer::default();
-        assert_eq!(s.echo_serial, 0);
-        assert_eq!(s.status, Status::NOT_READY);
-        assert!(s.error.is_none());
-        let c = CommandBuffer::<VerbId>::default();
-        assert_eq!((c.serial, c.verb()), (0, 0));
-        // Nothing sent, nothing written: the real NOT_READY shows through.
-        let mut l = SubordinateLink::new();
-        assert_eq!(l.observe(&Stamped::default()).status, Status::NOT_READY);
-    }
-
-    #[test]
-    fn status_echoing_older_serial_reads_executing() {
-        let mut l = SubordinateLink::new();
-        let s1 = l.next_command();
-        assert_eq!(
-            l.observe(&stamped(s1, Status::DONE, 1)).status,
-            Status::DONE
-        );
-        let s2 = l.next_command();
-        assert_eq!(s2, s1 + 1);
-        // The subordinate still shows DONE for s1: a stale DONE.
-        let v = l.observe(&stamped(s1, Status::DONE, 2));
-        assert_eq!(v.status, Status::EXECUTING);
-        assert!(!v.done());
-        assert_eq!(v.raw.status, Status::DONE);
-        // An ERROR for the older command is masked too.
-        let v = l.observe(&stamped(s1, Status::ERROR, 3));
-        assert_eq!((v.status, v.error), (Status::EXECUTING, ErrorCode::NONE));
-        // The echo arrives.
-        let v = l.observe(&stamped(s2, Status::ERROR, 4));
-        assert!(v.error());
-        assert_eq!(v.error, ErrorCode::custom(0));
-    }
-
-    #[test]
-    fn a_stale_echo_every_cycle_is_counted() {
-        // The subordinate writes its status every cycle (so `stale_cycles`
-        // stays 0) but keeps echoing the command before the last one.
-        let mut link = SubordinateLink::new();
-        let first = link.next_command();
-        let v = link.observe(&stamped(first, Status::DONE, 1));
-        assert_eq!(v.status, Status::DONE);
-        assert_eq!(link.old_echoes(), 0);
-        link.next_command();
-        for g in 2..12 {
-            let v = link.observe(&stamped(first, Status::DONE, g));
-            assert_eq!(v.stale_cycles, 0);
-            assert_eq!(v.status, Status::EXECUTING);
-        }
-        assert_eq!(link.old_echoes(), 10);
-    }
-
-    #[test]
-    fn stale_cycles_grow_for_silent_and_reset_for_live() {
-        let mut silent = SubordinateLink::new();
-        let mut live = SubordinateLink::new();
-        let frozen = stamped(0, Status::NOT_READY, 5);
-        for cycle in 0..10u64 {
-            let vs = silent.observe(&frozen);
-            let vl = live.observe(&stamped(0, Status::NOT_READY, 6 + cycle));
-            assert_eq!(vs.stale_cycles as u64, cycle);
-            assert_eq!(vl.stale_cycles, 0);
-        }
-        // Never written: stale from the first cycle.
-        let mut mute = SubordinateLink::new();
-        assert_eq!(mute.observe(&Stamped::default()).stale_cycles, 1);
-        assert_eq!(mute.observe(&Stamped::default()).stale_cycles, 2);
-    }
-
-    #[test]
-    fn status_ranges() {
-        let ok = StatusBuffer {
-            echo_serial: 9,
-            status: Status::custom(1),
-            error: ErrorCode::custom(2),
-            verb: 1,
-            state: 4,
-        };
-        assert_eq!(ok.check_range(2, 3, 2, 5), Ok(()));
-        let bad = |f: fn(&mut StatusBuffer)| {
-            let mut s = ok;
-            f(&mut s);
-            s.check_range(2, 3, 2, 5)
-        };
-        assert_eq!(bad(|s| s.status = Status(u16::MAX)), Err("status"));
-        assert_eq!(bad(|s| s.status = Status::custom(2)), Err("status"));
-        assert_eq!(
-            bad(|s| s.error = ErrorCode(u16::MAX - 7)),
-            Err("error code")
-        );
-        assert_eq!(bad(|s| s.error = ErrorCode::custom(3)), Err("error code"));
-        assert_eq!(bad(|s| s.error = ErrorCode::INDEX_RANGE), Ok(()));
-        assert_eq!(bad(|s| s.error = ErrorCode::UNKNOWN_COMMAND), Ok(()));
-        assert_eq!(bad(|s| s.verb = 2), Err("verb"));
-        assert_eq!(bad(|s| s.state = 5), Err("state"));
-        // The zeroed buffer of a controller that has no verbs yet.
-        assert_eq!(StatusBuffer::default().check_range(0, 0, 0, 0), Ok(()));
-    }
-
-    #[test]
-    fn status_codes() {
-        assert_eq!(Status::custom(0), Status(4));
-        assert_eq!(Status::DONE.builtin_name(), Some("DONE"));
-        assert_eq!(Status::custom(1).builtin_name(), None);
-        assert_eq!(ErrorCode::custom(0), ErrorCode(2));
-        assert!(!ErrorCode::UNKNOWN_COMMAND.is_none());
-    }
-
-    #[test]
-    fn subordinate_port_round_trip() {
-        let gm = GlobalMemory::new();
-        let mut sub = Subordinate::<VerbId>::connect(&gm, "TB").unwrap();
-        // Only one supervisor: the command writer is taken.
-        assert!(matches!(
-            Subordinate::<VerbId>::connect(&gm, "TB"),
-            Err(SetupError::WriterTaken(_))
-        ));
-        let cmd = gm.command_reader::<VerbId>("TB").unwrap();
-        let mut st = gm.status_writer("TB").unwrap();
-        assert!(!sub.flush(1));
-        assert_eq!(cmd.read().generation, 0);
-        let serial = sub.send(3);
-        assert!(sub.flush(1));
-        let c = cmd.read();
-        assert_eq!(
-            (c.value.serial, c.value.verb(), c.writer_cycle),
-            (serial, 3, 1)
-        );
-        assert!(sub.read().executing());
-        st.write(
-            StatusBuffer {
-                echo_serial: serial,
-                status: Status::DONE,
-                ..Default::default()
-            },
-            7,
-        );
-        assert!(sub.read().done());
-        assert!(sub.view().done());
-        assert_eq!(sub.last_command().serial, serial);
-    }
-}
+mod tests;

@@ -136,7 +136,7 @@
 //!     }
 //! }
 //!
-//! # fn main() -> Result<(), rcs_runtime::SetupError> {
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! // Setup: Global Memory, handles, the executive. Allocation is fine here.
 //! let gm = GlobalMemory::new();
 //! gm.declare_controller::<TbCommand>("TB")?;
@@ -159,13 +159,13 @@
 //!
 //! // Run: command, cycle, watch the status through the handshake.
 //! operator.command(TbCommand::Spin { rpm: 100.0 });
-//! cpu.step();
+//! cpu.step()?;
 //! assert_eq!(operator.view().status, Status::EXECUTING);
 //! sensor.write(99.5, 1);
-//! cpu.step();
+//! cpu.step()?;
 //! assert_eq!(operator.view().status, AT_SPEED);
 //! sensor.write(250.0, 2);
-//! cpu.step();
+//! cpu.step()?;
 //! assert_eq!(operator.outcome(), Some((Status::ERROR, OVERSPEED)));
 //! assert_eq!(cpu.cycle(), 3);
 //! # Ok(())
@@ -186,10 +186,13 @@ pub mod acl;
 #[cfg(feature = "zenoh")]
 pub mod bridge;
 pub mod driver;
+pub mod epoch;
 pub mod error;
 pub mod exec;
+pub mod fault;
 pub mod gm;
 pub mod handshake;
+pub mod heartbeat;
 pub mod index;
 pub mod math;
 pub mod operator;
@@ -202,11 +205,13 @@ pub mod trace;
 pub use acl::{Security, TlsFiles};
 #[cfg(feature = "zenoh")]
 pub use bridge::{Bridge, BridgeConfig, BridgeError};
+pub use epoch::fresh_epoch;
 pub use error::SetupError;
 pub use exec::{
     Controller, ControllerStats, CycleContext, Executive, ExecutiveConfig, ExecutiveHandle,
     ExecutiveStats, Heartbeat, Wait,
 };
+pub use fault::{ControllerPanic, CycleFault};
 pub use gm::{
     command_buffer_name, status_buffer_name, status_fields_buffer_name, BufferData, GlobalMemory,
     Reader, Stamped, Writer,

@@ -37,20 +37,29 @@ impl<C: Command> Operator<C> {
     pub fn connect(gm: &GlobalMemory, root: &str) -> Result<Self, SetupError> {
         gm.declare_controller::<C>(root)?;
         Ok(Self {
-            link: SubordinateLink::new(),
+            link: SubordinateLink::fresh(),
             command: Arc::new(Mutex::new(gm.command_writer(root)?)),
             status: gm.status_reader(root)?,
             sent: 0,
         })
     }
 
-    /// Send a new command (next serial) at once. Returns its serial. The
-    /// write is stamped with the number of commands the operator has sent.
+    /// Send a new command (next serial, this operator's epoch) at once.
+    /// Returns its serial. The write is stamped with the number of commands
+    /// the operator has sent.
     pub fn command(&mut self, command: C) -> u32 {
         let serial = self.link.next_command();
+        let epoch = self.link.epoch();
         self.sent = self.sent.wrapping_add(1);
         let mut writer = self.command.lock().unwrap_or_else(|p| p.into_inner());
-        writer.write(CommandBuffer { serial, command }, self.sent);
+        writer.write(
+            CommandBuffer {
+                serial,
+                epoch,
+                command,
+            },
+            self.sent,
+        );
         serial
     }
 
@@ -92,9 +101,16 @@ impl<C: Command> Operator<C> {
         Arc::clone(&self.command)
     }
 
-    /// Start serials after `serial` (e.g. to test wrap-around).
+    /// Start serials after `serial` (e.g. to test wrap-around; the command
+    /// after `u32::MAX` takes a fresh epoch).
     pub fn set_last_serial(&mut self, serial: u32) {
         self.link.set_last_sent(serial);
+    }
+
+    /// The epoch of this operator's commands (a fresh one per connection:
+    /// a restarted operator is never answered by its predecessor's status).
+    pub fn epoch(&self) -> u32 {
+        self.link.epoch()
     }
 }
 

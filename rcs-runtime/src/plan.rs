@@ -11,12 +11,17 @@
 //! A cycle of a controller, with `bk` its bookkeeping:
 //!
 //! 1. read inputs (command buffer, subordinates, `reads` buffers);
-//! 2. `bk.begin_cycle(tick, &cmd, has_plan)` — the new-command check (step 3);
+//! 2. `bk.begin_cycle(tick, &cmd, has_plan)` — the new-command check (step 3),
+//!    on the command's serial and epoch together;
 //! 3. if `bk.is_active()`: walk the rows of the plan of `bk.verb()` in
 //!    `bk.state()`, run the first match's jobs (which may call
 //!    `bk.report(..)`), then `bk.fire(row, target)` (step 4);
 //! 4. write outputs, the status buffer from `bk.status_buffer()` (step 5);
 //! 5. `bk.end_cycle()` (step 6).
+//!
+//! If the cycle panicked (a hook), the executive calls the controller's
+//! [`fault`](crate::Controller::fault), which ends the plan through
+//! [`Bookkeeping::fault`] with `HOOK_PANIC` and publishes the status.
 
 use std::time::Instant;
 
@@ -128,6 +133,10 @@ pub enum NewCommand {
 #[derive(Debug, Clone)]
 pub struct Bookkeeping {
     echo_serial: u32,
+    echo_epoch: u32,
+    /// Commands overwritten in the command buffer before this controller
+    /// read them (serial jumps within one epoch).
+    commands_lost: u64,
     verb: VerbId,
     state: StateId,
     status: Status,
@@ -150,6 +159,8 @@ impl Bookkeeping {
     pub fn new(verb_count: usize) -> Self {
         Self {
             echo_serial: 0,
+            echo_epoch: 0,
+            commands_lost: 0,
             verb: 0,
             state: S0,
             status: Status::NOT_READY,
@@ -174,29 +185,36 @@ impl Bookkeeping {
         cmd: &CommandBuffer<C>,
         has_plan: bool,
     ) -> NewCommand {
-        self.begin_cycle_raw(tick, cmd.serial, cmd.verb(), has_plan)
+        self.begin_cycle_raw(tick, cmd.serial, cmd.epoch, cmd.verb(), has_plan)
     }
 
     /// Step 3: the new-command check. `has_plan` says whether `verb` has a
     /// plan (generated code: always, for a verb of its enum; an interpreter:
     /// whether its plan table has the verb).
     ///
-    /// On a new serial: echo it, status EXECUTING, error cleared, the plan of
-    /// `verb` becomes active in `S0` with both counters 0. The running
-    /// command, if any, is superseded at once and never resumed. Without a
-    /// plan: status ERROR, error UNKNOWN_COMMAND, no active plan.
+    /// A command is new when its serial or its epoch differs from the ones
+    /// echoed (a restarted supervisor, or one whose serials wrapped, sends
+    /// another epoch). On a new command: echo both, status EXECUTING, error
+    /// cleared, the plan of `verb` becomes active in `S0` with both counters
+    /// 0. The running command, if any, is superseded at once and never
+    /// resumed. Without a plan: status ERROR, error UNKNOWN_COMMAND, no
+    /// active plan. A serial more than one past the echoed one in the same
+    /// epoch means commands were overwritten unread: they are counted in
+    /// [`commands_lost`](Self::commands_lost).
     #[inline]
     pub fn begin_cycle_raw(
         &mut self,
         tick: Tick,
         serial: u32,
+        epoch: u32,
         verb: VerbId,
         has_plan: bool,
     ) -> NewCommand {
         self.fired = None;
         self.index_range = false;
         self.now = Some(tick.now);
-        if serial == self.echo_serial {
+        // Serial 0 is a buffer never written, whatever its epoch.
+        if serial == 0 || (serial == self.echo_serial && epoch == self.echo_epoch) {
             self.new_command = false;
             return NewCommand::No;
         }
@@ -205,8 +223,13 @@ impl Bookkeeping {
                 s.superseded = s.superseded.saturating_add(1);
             }
         }
+        if self.echo_serial != 0 && epoch == self.echo_epoch && serial > self.echo_serial {
+            let skipped = serial - self.echo_serial - 1;
+            self.commands_lost = self.commands_lost.saturating_add(u64::from(skipped));
+        }
         self.new_command = true;
         self.echo_serial = serial;
+        self.echo_epoch = epoch;
         self.verb = verb;
         self.state = S0;
         self.state_cycles = 0;
@@ -337,6 +360,16 @@ impl Bookkeeping {
         }
     }
 
+    /// The cycle was cut short by a fault (a panicking hook): status ERROR
+    /// with `code`, and the active plan (if any) ends as `Error(code)`
+    /// would end it. The next command starts normally.
+    #[inline]
+    pub fn fault(&mut self, code: ErrorCode) {
+        self.status = Status::ERROR;
+        self.error = code;
+        self.finish(false);
+    }
+
     /// Step 6: count the cycle (`state_cycles` and `plan_cycles` grow by
     /// one, saturating).
     #[inline]
@@ -350,6 +383,7 @@ impl Bookkeeping {
     pub fn status_buffer(&self) -> StatusBuffer {
         StatusBuffer {
             echo_serial: self.echo_serial,
+            echo_epoch: self.echo_epoch,
             status: self.status,
             error: self.error,
             verb: self.verb,
@@ -365,6 +399,17 @@ impl Bookkeeping {
     /// The serial of the command being executed (0: none yet).
     pub fn echo_serial(&self) -> u32 {
         self.echo_serial
+    }
+    /// The epoch of the command being executed (0: none yet).
+    pub fn echo_epoch(&self) -> u32 {
+        self.echo_epoch
+    }
+    /// Commands overwritten in the command buffer before this controller
+    /// read them: a supervisor that sends several commands within one of
+    /// this controller's cycles loses all but the last (the subordinate sees
+    /// the serial jump by more than one within one epoch).
+    pub fn commands_lost(&self) -> u64 {
+        self.commands_lost
     }
     /// The verb of the current (or last) command.
     pub fn verb(&self) -> VerbId {
@@ -406,191 +451,4 @@ impl Bookkeeping {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    const INIT: VerbId = 0;
-    const MOVE: VerbId = 1;
-
-    fn tick(c: u64) -> Tick {
-        Tick::now(c)
-    }
-
-    #[test]
-    fn idle_until_first_command() {
-        let mut bk = Bookkeeping::new(2);
-        assert_eq!(bk.begin_cycle_raw(tick(0), 0, 0, true), NewCommand::No);
-        assert!(!bk.is_active() && !bk.new_command() && !bk.finished());
-        assert_eq!(bk.status_buffer(), StatusBuffer::default());
-        assert!(!bk.fire(0, Target::Done), "nothing fires without a plan");
-    }
-
-    #[test]
-    fn new_command_resets_and_starts_in_s0() {
-        let mut bk = Bookkeeping::new(2);
-        assert_eq!(
-            bk.begin_cycle_raw(tick(0), 1, MOVE, true),
-            NewCommand::Started
-        );
-        assert!(bk.new_command() && bk.is_active());
-        assert_eq!(
-            bk.status_buffer(),
-            StatusBuffer {
-                echo_serial: 1,
-                status: Status::EXECUTING,
-                error: ErrorCode::NONE,
-                verb: MOVE,
-                state: S0
-            }
-        );
-        assert!(bk.fire(0, Target::State(1)));
-        bk.end_cycle();
-        assert_eq!(bk.begin_cycle_raw(tick(1), 1, MOVE, true), NewCommand::No);
-        assert!(!bk.new_command());
-        assert_eq!((bk.state(), bk.state_cycles(), bk.plan_cycles()), (1, 1, 1));
-    }
-
-    #[test]
-    fn state_cycles_reset_only_when_state_differs() {
-        let mut bk = Bookkeeping::new(1);
-        bk.begin_cycle_raw(tick(0), 1, 0, true);
-        bk.fire(0, Target::State(1));
-        bk.end_cycle();
-        for c in 1..5 {
-            bk.begin_cycle_raw(tick(c), 1, 0, true);
-            bk.fire(1, Target::State(1)); // same state by name
-            bk.end_cycle();
-        }
-        assert_eq!(bk.state_cycles(), 5);
-        bk.begin_cycle_raw(tick(5), 1, 0, true);
-        bk.fire(2, Target::Same);
-        bk.end_cycle();
-        assert_eq!(bk.state_cycles(), 6);
-        bk.begin_cycle_raw(tick(6), 1, 0, true);
-        bk.fire(3, Target::State(2));
-        assert_eq!(bk.state_cycles(), 0);
-        bk.end_cycle();
-        assert_eq!((bk.state_cycles(), bk.plan_cycles()), (1, 7));
-    }
-
-    #[test]
-    fn at_most_one_row_fires_per_cycle() {
-        let mut bk = Bookkeeping::new(1);
-        bk.begin_cycle_raw(tick(0), 1, 0, true);
-        assert!(bk.fire(0, Target::State(1)));
-        assert!(!bk.fire(1, Target::State(2)));
-        assert_eq!((bk.fired(), bk.state()), (Some(0), 1));
-        bk.end_cycle();
-        bk.begin_cycle_raw(tick(1), 1, 0, true);
-        assert_eq!(bk.fired(), None, "fired is per cycle");
-    }
-
-    #[test]
-    fn done_and_error_finish_the_plan() {
-        let mut bk = Bookkeeping::new(2);
-        bk.begin_cycle_raw(tick(0), 1, INIT, true);
-        bk.end_cycle();
-        bk.begin_cycle_raw(tick(1), 1, INIT, true);
-        assert!(bk.fire(1, Target::Done));
-        assert!(bk.finished() && !bk.is_active());
-        assert_eq!(bk.status(), Status::DONE);
-        bk.end_cycle();
-        // A finished plan does nothing until a new command.
-        bk.begin_cycle_raw(tick(2), 1, INIT, true);
-        assert!(!bk.is_active());
-        assert!(!bk.fire(0, Target::State(3)));
-        assert_eq!(bk.status(), Status::DONE);
-        let s = bk.verb_stats()[usize::from(INIT)];
-        assert_eq!((s.done, s.errors, s.cycles.last), (1, 0, 2));
-
-        bk.begin_cycle_raw(tick(3), 2, MOVE, true);
-        assert_eq!(
-            (bk.status(), bk.error()),
-            (Status::EXECUTING, ErrorCode::NONE)
-        );
-        bk.fire(0, Target::Error(ErrorCode::custom(1)));
-        assert_eq!(
-            (bk.status(), bk.error()),
-            (Status::ERROR, ErrorCode::custom(1))
-        );
-        assert_eq!(bk.verb_stats()[usize::from(MOVE)].errors, 1);
-        // The error is cleared by the next new command.
-        bk.end_cycle();
-        bk.begin_cycle_raw(tick(4), 3, MOVE, true);
-        assert_eq!(
-            (bk.status(), bk.error()),
-            (Status::EXECUTING, ErrorCode::NONE)
-        );
-    }
-
-    #[test]
-    fn unknown_verb_reports_unknown_command() {
-        let mut bk = Bookkeeping::new(2);
-        assert_eq!(
-            bk.begin_cycle_raw(tick(0), 1, 9, false),
-            NewCommand::Unknown
-        );
-        assert!(bk.new_command());
-        assert!(!bk.is_active());
-        assert_eq!(
-            (bk.status(), bk.error(), bk.echo_serial()),
-            (Status::ERROR, ErrorCode::UNKNOWN_COMMAND, 1)
-        );
-        assert!(!bk.fire(0, Target::Done));
-    }
-
-    #[test]
-    fn new_command_supersedes_running_one_at_once() {
-        let mut bk = Bookkeeping::new(2);
-        bk.begin_cycle_raw(tick(0), 1, MOVE, true);
-        bk.fire(0, Target::State(3));
-        bk.report(Status::custom(0));
-        bk.end_cycle();
-        bk.begin_cycle_raw(tick(1), 2, INIT, true);
-        assert!(bk.new_command() && bk.is_active());
-        assert_eq!(
-            (bk.verb(), bk.state(), bk.status()),
-            (INIT, S0, Status::EXECUTING)
-        );
-        assert_eq!((bk.state_cycles(), bk.plan_cycles()), (0, 0));
-        assert_eq!(bk.verb_stats()[usize::from(MOVE)].superseded, 1);
-    }
-
-    #[test]
-    fn report_stays_until_changed() {
-        let mut bk = Bookkeeping::new(1);
-        bk.begin_cycle_raw(tick(0), 1, 0, true);
-        bk.report(Status::custom(0));
-        bk.fire(0, Target::State(1));
-        bk.end_cycle();
-        for c in 1..4 {
-            bk.begin_cycle_raw(tick(c), 1, 0, true);
-            bk.end_cycle();
-            assert_eq!(bk.status(), Status::custom(0));
-        }
-        bk.begin_cycle_raw(tick(4), 1, 0, true);
-        bk.fire(1, Target::Done);
-        assert_eq!(bk.status(), Status::DONE);
-    }
-
-    #[test]
-    fn counters_saturate() {
-        let mut bk = Bookkeeping::new(1);
-        bk.begin_cycle_raw(tick(0), 1, 0, true);
-        bk.state_cycles = u32::MAX - 1;
-        bk.plan_cycles = u32::MAX;
-        bk.end_cycle();
-        bk.end_cycle();
-        assert_eq!((bk.state_cycles(), bk.plan_cycles()), (u32::MAX, u32::MAX));
-    }
-
-    #[test]
-    fn sample_stats() {
-        let mut s = SampleStats::default();
-        assert_eq!(s.mean(), 0);
-        for v in [5, 1, 9] {
-            s.record(v);
-        }
-        assert_eq!((s.count, s.last, s.min, s.max, s.mean()), (3, 9, 1, 9, 5));
-    }
-}
+mod tests;

@@ -60,13 +60,13 @@ impl<T: Schema, const N: usize> Schema for [T; N] {
 
 impl Schema for StatusBuffer {
     const SCHEMA: u64 = combine(
-        "StatusBuffer{echo_serial:u32,status:u16,error:u16,verb:u16,state:u16}",
+        "StatusBuffer{echo_serial:u32,echo_epoch:u32,status:u16,error:u16,verb:u16,state:u16}",
         &[],
     );
 }
 
 impl<C: Schema> Schema for CommandBuffer<C> {
-    const SCHEMA: u64 = combine("CommandBuffer{serial:u32,command}", &[C::SCHEMA]);
+    const SCHEMA: u64 = combine("CommandBuffer{serial:u32,epoch:u32,command}", &[C::SCHEMA]);
 }
 
 #[cfg(test)]

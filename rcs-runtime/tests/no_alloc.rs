@@ -110,19 +110,19 @@ fn ten_thousand_cycles_allocate_nothing() {
     let handle = exec.handle();
     // Warm up once (first-touch effects, lazily initialised statics).
     op.command(GO);
-    exec.run_cycles(10);
+    exec.run_cycles(10).unwrap();
 
     let (allocations, done) = allocations_in(|| {
         let mut done = 0;
         for round in 0..100u32 {
             // Alternate a completing command and a superseding one.
             op.command(if round % 3 == 2 { HOLD } else { GO });
-            exec.run_cycles(50);
+            exec.run_cycles(50).unwrap();
             if op.outcome() == Some((Status::DONE, Default::default())) {
                 done += 1;
             }
             op.command(GO);
-            exec.run_cycles(50);
+            exec.run_cycles(50).unwrap();
             let _ = handle.cycle();
         }
         done
@@ -183,7 +183,7 @@ fn cycles_allocate_nothing_with_the_bridge_running() {
         let stop = Arc::clone(&stop);
         std::thread::spawn(move || {
             while !stop.load(Ordering::Relaxed) {
-                engine.step();
+                engine.step().unwrap();
                 std::thread::sleep(Duration::from_millis(1));
             }
         })
@@ -194,7 +194,7 @@ fn cycles_allocate_nothing_with_the_bridge_running() {
     op.command(GO);
     let deadline = Instant::now() + Duration::from_secs(60);
     while tb_status.generation() == 0 && Instant::now() < deadline {
-        exec.run_cycles(1);
+        exec.run_cycles(1).unwrap();
         std::thread::sleep(Duration::from_millis(1));
     }
     assert!(
@@ -212,7 +212,7 @@ fn cycles_allocate_nothing_with_the_bridge_running() {
             if cycles.is_multiple_of(40) {
                 op.command(if cycles.is_multiple_of(120) { HOLD } else { GO });
             }
-            exec.run_cycles(1);
+            exec.run_cycles(1).unwrap();
             cycles += 1;
             std::thread::sleep(Duration::from_micros(500));
         }

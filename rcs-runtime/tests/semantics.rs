@@ -44,7 +44,7 @@ fn command_flows_down_and_done_flows_up() {
     assert_eq!(serial, 1);
     // Cycle 0: SM, PR and TB all pick up their command in the same cycle,
     // since a subordinate that runs after its supervisor sees the write.
-    e.step();
+    e.step().unwrap();
     for c in ["SM", "PR", "TB"] {
         let s = status(&gm, c);
         assert_eq!(
@@ -55,7 +55,7 @@ fn command_flows_down_and_done_flows_up() {
     }
     let mut cycles = 1;
     while op.outcome().is_none() {
-        e.step();
+        e.step().unwrap();
         cycles += 1;
         assert!(cycles < 20);
     }
@@ -94,31 +94,33 @@ fn sup_with_fake_sub() -> (
 fn stale_done_never_completes_a_newer_command() {
     let (gm, mut e, mut op, mut xs, xc) = sup_with_fake_sub();
     op.command(GO);
-    e.step();
+    e.step().unwrap();
     let first = xc.read().value.serial;
     assert_eq!(first, 1);
+    let epoch = xc.read().value.epoch;
     // X finishes the first command.
     let done = |serial| StatusBuffer {
         echo_serial: serial,
+        echo_epoch: epoch,
         status: Status::DONE,
         ..Default::default()
     };
     xs.write(done(first), 1);
     // A new command to PR before it saw the DONE: PR sends X a new command.
     op.command(GO);
-    e.step();
+    e.step().unwrap();
     let second = xc.read().value.serial;
     assert_eq!(second, 2);
     // X keeps showing DONE for the first command for many cycles.
     for c in 0..10 {
         xs.write(done(first), 2 + c);
-        e.step();
+        e.step().unwrap();
         assert_eq!(status(&gm, "PR").status, Status::EXECUTING);
         assert_eq!(op.outcome(), None);
     }
     // X echoes the second command: now it counts.
     xs.write(done(second), 20);
-    e.step();
+    e.step().unwrap();
     assert_eq!(status(&gm, "PR").status, Status::DONE);
     assert_eq!(op.outcome(), Some((Status::DONE, ErrorCode::NONE)));
 }
@@ -127,17 +129,18 @@ fn stale_done_never_completes_a_newer_command() {
 fn subordinate_error_is_passed_up() {
     let (_gm, mut e, mut op, mut xs, xc) = sup_with_fake_sub();
     op.command(GO);
-    e.step();
+    e.step().unwrap();
     xs.write(
         StatusBuffer {
             echo_serial: xc.read().value.serial,
+            echo_epoch: xc.read().value.epoch,
             status: Status::ERROR,
             error: ErrorCode::custom(5),
             ..Default::default()
         },
         1,
     );
-    e.step();
+    e.step().unwrap();
     assert_eq!(op.outcome(), Some((Status::ERROR, SUB_FAILED)));
 }
 
@@ -145,10 +148,10 @@ fn subordinate_error_is_passed_up() {
 fn new_command_supersedes_the_running_one_at_once() {
     let (gm, mut e, mut op) = hierarchy(1000);
     op.command(GO);
-    e.run_cycles(5);
+    e.run_cycles(5).unwrap();
     assert_eq!(status(&gm, "TB").status, Status::EXECUTING);
     let s = op.command(HOLD);
-    e.step();
+    e.step().unwrap();
     // In the very cycle of the new command every level switched to HOLD.
     for c in ["SM", "PR", "TB"] {
         let st = status(&gm, c);
@@ -160,7 +163,7 @@ fn new_command_supersedes_the_running_one_at_once() {
     }
     assert_eq!(status(&gm, "SM").echo_serial, s);
     // GO is never resumed: HOLD is continuous, it stays EXECUTING forever.
-    e.run_cycles(2000);
+    e.run_cycles(2000).unwrap();
     for c in ["SM", "PR", "TB"] {
         assert_eq!(status(&gm, c).verb, HOLD);
     }
@@ -174,23 +177,114 @@ fn serial_wrap_around_is_still_a_new_command() {
     let (gm, mut e, mut op) = hierarchy(1);
     op.set_last_serial(u32::MAX - 1);
     assert_eq!(op.command(GO), u32::MAX);
-    e.run_cycles(10);
+    e.run_cycles(10).unwrap();
     assert_eq!(op.outcome(), Some((Status::DONE, ErrorCode::NONE)));
     assert_eq!(status(&gm, "SM").echo_serial, u32::MAX);
     // Wraps to 1, never 0.
     assert_eq!(op.command(GO), 1);
-    e.step();
+    e.step().unwrap();
     assert_eq!(status(&gm, "SM").echo_serial, 1);
     assert_eq!(status(&gm, "SM").status, Status::EXECUTING);
-    e.run_cycles(10);
+    e.run_cycles(10).unwrap();
     assert_eq!(op.outcome(), Some((Status::DONE, ErrorCode::NONE)));
+}
+
+/// What a subordinate shows when it finished `cmd`.
+fn done_for(cmd: rcs_runtime::CommandBuffer<VerbId>) -> StatusBuffer {
+    StatusBuffer {
+        echo_serial: cmd.serial,
+        echo_epoch: cmd.epoch,
+        status: Status::DONE,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn a_restarted_supervisor_is_not_answered_by_the_old_done_for_serial_one() {
+    // The first incarnation of PR sends X its command 1, and X finishes it.
+    let (_gm, mut e, mut op, mut xs, xc) = sup_with_fake_sub();
+    op.command(GO);
+    e.step().unwrap();
+    let old = xc.read().value;
+    assert_eq!(old.serial, 1);
+    xs.write(done_for(old), 1);
+    e.step().unwrap();
+    assert_eq!(op.outcome(), Some((Status::DONE, ErrorCode::NONE)));
+    drop((e, op));
+
+    // PR's process restarts (fresh Global Memory and links); X, in another
+    // process, still shows DONE for serial 1 of the previous incarnation.
+    let (gm, mut e, mut op, mut xs, xc) = sup_with_fake_sub();
+    xs.write(done_for(old), 1);
+    op.command(GO);
+    e.step().unwrap();
+    let new = xc.read().value;
+    assert_eq!(new.serial, 1, "the serials start again");
+    assert_ne!(new.epoch, old.epoch);
+    for c in 0..10 {
+        xs.write(done_for(old), 2 + c);
+        e.step().unwrap();
+        assert_eq!(status(&gm, "PR").status, Status::EXECUTING);
+        assert_eq!(op.outcome(), None, "the old DONE answered the new command");
+    }
+    xs.write(done_for(new), 20);
+    e.step().unwrap();
+    assert_eq!(op.outcome(), Some((Status::DONE, ErrorCode::NONE)));
+}
+
+#[test]
+fn after_a_serial_wrap_the_old_done_for_serial_one_does_not_answer() {
+    let (gm, mut e, mut op, mut xs, xc) = sup_with_fake_sub();
+    op.command(GO);
+    e.step().unwrap();
+    let old = xc.read().value;
+    assert_eq!(old.serial, 1);
+    xs.write(done_for(old), 1);
+    e.step().unwrap();
+    assert_eq!(op.outcome(), Some((Status::DONE, ErrorCode::NONE)));
+    // 2³² - 2 commands later PR's serials to X wrap back to 1.
+    let pr = e.controller_as_mut::<Relay>("PR").unwrap();
+    pr.sub.as_mut().unwrap().link_mut().set_last_sent(u32::MAX);
+    op.command(GO);
+    e.step().unwrap();
+    let new = xc.read().value;
+    assert_eq!(new.serial, 1);
+    assert_ne!(new.epoch, old.epoch);
+    for c in 0..10 {
+        xs.write(done_for(old), 2 + c);
+        e.step().unwrap();
+        assert_eq!(status(&gm, "PR").status, Status::EXECUTING);
+    }
+    xs.write(done_for(new), 20);
+    e.step().unwrap();
+    assert_eq!(op.outcome(), Some((Status::DONE, ErrorCode::NONE)));
+}
+
+#[test]
+fn a_burst_of_a_thousand_commands_in_one_cycle_is_counted() {
+    let (_gm, mut e, mut op) = hierarchy(1000);
+    op.command(GO);
+    e.step().unwrap();
+    assert_eq!(e.commands_lost("SM"), 0);
+    // 1,000 commands before SM's next cycle: it reads only the last.
+    for _ in 0..1000 {
+        op.command(HOLD);
+    }
+    e.step().unwrap();
+    assert_eq!(e.commands_lost("SM"), 999);
+    let sm = e.controller("SM").unwrap().bookkeeping().unwrap();
+    assert_eq!(sm.verb_stats()[usize::from(GO)].superseded, 1);
+    assert_eq!(sm.verb(), HOLD);
+    // SM sends PR one command per cycle: nothing lost below.
+    assert_eq!(e.commands_lost("PR"), 0);
+    assert_eq!(e.commands_lost("NOBODY"), 0);
 }
 
 #[test]
 fn unknown_verb_from_an_outside_writer() {
     let (gm, mut e, mut op) = hierarchy(1);
     op.command(7);
-    e.step();
+    e.step().unwrap();
     let s = status(&gm, "SM");
     assert_eq!(
         (s.status, s.error, s.echo_serial),
@@ -198,7 +292,7 @@ fn unknown_verb_from_an_outside_writer() {
     );
     // No active plan: nothing sent down.
     assert_eq!(status(&gm, "PR").echo_serial, 0);
-    e.run_cycles(3);
+    e.run_cycles(3).unwrap();
     assert_eq!(status(&gm, "SM").status, Status::ERROR);
 }
 
@@ -235,7 +329,7 @@ fn silent_subordinate_goes_stale_live_one_does_not() {
         seen: Arc::clone(&seen),
     }))
     .unwrap();
-    e.run_cycles(10);
+    e.run_cycles(10).unwrap();
     let seen = seen.lock().unwrap();
     let expect: Vec<(u32, u32)> = (1..=10).map(|n| (0, n)).collect();
     assert_eq!(*seen, expect);
@@ -256,7 +350,7 @@ fn overrun_is_counted_when_a_controller_exceeds_the_period() {
     let mut e = exec("main", 1);
     e.add(Box::new(Sleeper(Duration::from_millis(3)))).unwrap();
     let h = e.handle();
-    e.run_cycles(3);
+    e.run_cycles(3).unwrap();
     assert_eq!(e.overruns(), 3);
     assert_eq!(h.overruns(), 3);
     assert_eq!(e.controller_stats("SLOW").unwrap().overruns, 3);
@@ -268,16 +362,16 @@ fn overrun_is_counted_when_a_controller_exceeds_the_period() {
     // loaded machine comes near).
     let mut fast = Executive::new(ExecutiveConfig::new("fast", Duration::from_secs(3600))).unwrap();
     fast.add(Box::new(Sleeper(Duration::ZERO))).unwrap();
-    fast.run_cycles(10);
+    fast.run_cycles(10).unwrap();
     assert_eq!(fast.overruns(), 0);
 }
 
 #[test]
 fn single_step_runs_exactly_one_cycle() {
     let (_gm, mut e, _op) = hierarchy(1);
-    e.step();
+    e.step().unwrap();
     assert_eq!(e.cycle(), 1);
-    e.run_cycles(4);
+    e.run_cycles(4).unwrap();
     assert_eq!(e.cycle(), 5);
 
     // Through the handle, on a running heartbeat executive.
@@ -426,7 +520,7 @@ fn trace_sink_writes_one_json_line_per_controller_per_cycle() {
     let buf = SharedBuf::default();
     e.set_trace(TraceSink::new(buf.clone()));
     op.command(GO);
-    e.run_cycles(4);
+    e.run_cycles(4).unwrap();
     let sink = e.take_trace().unwrap();
     assert_eq!((sink.records(), sink.errors()), (12, 0));
     let text = String::from_utf8(buf.0.lock().unwrap().clone()).unwrap();
@@ -451,11 +545,11 @@ fn same_inputs_give_the_same_trace() {
         let buf = SharedBuf::default();
         e.set_trace(TraceSink::new(buf.clone()));
         op.command(GO);
-        e.run_cycles(6);
+        e.run_cycles(6).unwrap();
         op.command(HOLD);
-        e.run_cycles(3);
+        e.run_cycles(3).unwrap();
         op.command(GO);
-        e.run_cycles(8);
+        e.run_cycles(8).unwrap();
         let out = buf.0.lock().unwrap().clone();
         out
     };

@@ -127,7 +127,10 @@ fn main() -> ExitCode {
     for (cycle, (event, note)) in SCRIPT.iter().enumerate() {
         system.inputs.ev.write(events(*event), cycle as u64);
         let before = system.gx().map_or_else(|| "?".into(), place);
-        system.run_cycles(1);
+        if let Err(fault) = system.run_cycles(1) {
+            eprintln!("figure13: {fault}");
+            return ExitCode::FAILURE;
+        }
         let Some(gx) = system.gx() else {
             eprintln!("figure13: the executive has no GX");
             return ExitCode::from(2);

@@ -111,9 +111,10 @@ impl<
     /// The turbine answers DONE to the last command; the ship moves on.
     #[inline]
     fn world(&mut self) {
-        let sent = self.tb_command.read().value.serial;
+        let sent = self.tb_command.read().value;
         let done = StatusBuffer {
-            echo_serial: sent,
+            echo_serial: sent.serial,
+            echo_epoch: sent.epoch,
             status: Status::DONE,
             ..StatusBuffer::default()
         };

@@ -49,7 +49,7 @@ fn a_system_gives_typed_controllers_while_it_holds_their_executive() {
         .operators
         .sm
         .command(sm::Command::Transit { speed: 4.0 });
-    system.run_cycles(2);
+    system.run_cycles(2).expect("no hook panics");
     let pr = system.pr().expect("PR");
     assert_eq!(pr.verb_name(), Some("AHEAD"));
     assert_eq!(pr.state_name(), Some("S1"));
@@ -86,7 +86,7 @@ fn a_system_gives_typed_controllers_while_it_holds_their_executive() {
 }
 
 /// Every error a controller can report has a variant of its `Error`: the
-/// two built-ins (`UNKNOWN_COMMAND`, `INDEX_RANGE`) as well as the declared
+/// built-ins (`UNKNOWN_COMMAND`, `INDEX_RANGE`, `HOOK_PANIC`) as well as the declared
 /// codes, each going to its runtime code and back and named as in the plans.
 #[test]
 fn built_in_and_declared_errors_round_trip_through_the_typed_error() {
@@ -98,6 +98,7 @@ fn built_in_and_declared_errors_round_trip_through_the_typed_error() {
             "UNKNOWN_COMMAND",
         ),
         (pr::Error::IndexRange, ErrorCode::INDEX_RANGE, "INDEX_RANGE"),
+        (pr::Error::HookPanic, ErrorCode::HOOK_PANIC, "HOOK_PANIC"),
         (
             pr::Error::TurbineFailed,
             pr::error::TURBINE_FAILED,
@@ -110,10 +111,11 @@ fn built_in_and_declared_errors_round_trip_through_the_typed_error() {
         assert_eq!(typed.name(), name);
     }
     assert_eq!(pr::error::INDEX_RANGE, ErrorCode::INDEX_RANGE);
+    assert_eq!(pr::error::HOOK_PANIC, ErrorCode::HOOK_PANIC);
     assert_eq!(pr::Error::from_raw(ErrorCode::NONE), None);
-    // The declared codes sit between the two built-ins.
+    // The declared codes sit between the built-ins.
     assert_eq!(
-        pr::Error::from_raw(ErrorCode(ErrorCode::INDEX_RANGE.0 - 1)),
+        pr::Error::from_raw(ErrorCode(ErrorCode::HOOK_PANIC.0 - 1)),
         None
     );
 }

@@ -34,13 +34,13 @@ fn a_conditions_hook_call_runs_once_per_cycle_and_a_jobs_every_time() {
     })
     .expect("setup");
     system.operators.c.command(c::Command::Watch);
-    system.run_cycles(1); // E0: new command → S1, no hook asked
+    system.run_cycles(1).expect("no hook panics"); // E0: new command → S1, no hook asked
     let calls = |system: &mut System<Counting>| {
         std::mem::take(&mut system.c_mut().expect("C").hooks_mut().calls)
     };
     assert_eq!(calls(&mut system), Vec::<String>::new());
     for cycle in 1..4 {
-        system.run_cycles(1);
+        system.run_cycles(1).expect("no hook panics");
         assert_eq!(system.c().expect("C").bookkeeping().fired(), Some(3));
         // E1 asks depth() (false, so over(1) is never reached); E2 asks
         // over(2) and depth() again (cached); E3 asks both (cached). The

@@ -367,7 +367,7 @@ fn helm(opts: &Options) -> Result<bool, String> {
         .executives
         .first()
         .map_or(Duration::from_millis(30), |e| e.period());
-    let mut heartbeat = Heartbeat::new(period, Wait::default());
+    let mut heartbeat = Heartbeat::new(period, Wait::default()).map_err(|e| e.to_string())?;
     let mut last = String::new();
     let mut reached = false;
     let mut goal_seen = false;
@@ -380,7 +380,10 @@ fn helm(opts: &Options) -> Result<bool, String> {
             order(&mut system, speed);
             goal_seen = false;
         }
-        system.run_cycles(1);
+        if let Err(fault) = system.run_cycles(1) {
+            // Contained: the faulty controller's plan ended with HOOK_PANIC.
+            eprintln!("submarine-split: {fault}");
+        }
         let now = statuses(&system);
         // PR's watchdog count on TB: cycles since TB's status last changed.
         let stale = system.pr().map_or(0, |c| c.data().subs.tb.stale_cycles);
@@ -446,13 +449,16 @@ fn engine(opts: &Options) -> Result<bool, String> {
         watch.watch(&name, reader);
     }
     println!("engine: running");
-    let mut heartbeat = Heartbeat::new(period, Wait::default());
+    let mut heartbeat = Heartbeat::new(period, Wait::default()).map_err(|e| e.to_string())?;
     let mut last = String::new();
     let mut errors_shown = 0u64;
     let mut cycle = 0u64;
     while opts.cycles.is_none_or(|n| cycle < n) {
         heartbeat.wait();
-        system.run_cycles(1);
+        if let Err(fault) = system.run_cycles(1) {
+            // Contained: the faulty controller's plan ended with HOOK_PANIC.
+            eprintln!("submarine-split: {fault}");
+        }
         plant.step(system.outputs.drive.read().value, dt);
         ship.write(plant.ship(), cycle + 1);
         turbine.write(plant.turbine(), cycle + 1);
@@ -502,7 +508,10 @@ fn one_process(opts: &Options) -> Result<bool, String> {
         .sm
         .command(sm::Command::Transit { speed: opts.speed });
     for cycle in 0..opts.cycles.unwrap_or(2_000) {
-        system.run_cycles(1);
+        if let Err(fault) = system.run_cycles(1) {
+            // Contained: the faulty controller's plan ended with HOOK_PANIC.
+            eprintln!("submarine-split: {fault}");
+        }
         plant.step(system.outputs.drive.read().value, dt);
         if let (Some(ship), Some(turbine)) =
             (system.inputs.ship.as_mut(), system.inputs.turbine.as_mut())
@@ -527,3 +536,6 @@ fn statuses_of_helm(system: &Sub) -> String {
         .collect::<Vec<_>>()
         .join(" ")
 }
+
+#[cfg(test)]
+mod restart_tests;

@@ -383,7 +383,7 @@ fn run(
     // Real time: the executive's heartbeat (absolute deadlines, sleep then
     // spin), stepped here so that the simulators and the display run between
     // cycles on this thread.
-    let mut heartbeat = Heartbeat::new(period, Wait::default());
+    let mut heartbeat = Heartbeat::new(period, Wait::default())?;
     let mut lateness = SampleStats::default();
     let mut missed = 0u64;
     let started = Instant::now();
@@ -399,7 +399,11 @@ fn run(
     while goal_at.is_some() || cycle < opts.max_cycles {
         // What the controllers read this cycle.
         let read = plant;
-        system.run_cycles(1);
+        if let Err(fault) = system.run_cycles(1) {
+            // Contained: the controller's plan ended with HOOK_PANIC (the
+            // status check below sees the failure); say which and why.
+            eprintln!("submarine: {fault}");
+        }
         let drive = system.outputs.drive.read().value;
         plant.step(drive, dt);
         system.inputs.ship.write(plant.ship(), cycle + 1);
@@ -481,11 +485,13 @@ fn run(
     for name in exec.controller_names() {
         if let Some(s) = exec.controller_stats(name) {
             println!(
-                "  {name}: exec µs min {:.1}, mean {:.1}, max {:.1}; overruns {}",
+                "  {name}: exec µs min {:.1}, mean {:.1}, max {:.1}; overruns {}; panics {}; commands lost {}",
                 micros(s.exec_ns.min),
                 micros(s.exec_ns.mean()),
                 micros(s.exec_ns.max),
                 s.overruns,
+                s.panics,
+                exec.commands_lost(name),
             );
         }
     }

@@ -479,6 +479,8 @@ pub(crate) fn module(
                 pub const UNKNOWN_COMMAND: rt::ErrorCode = rt::ErrorCode::UNKNOWN_COMMAND;
                 /// An index by a run-time value outside its array (the cycle ended the plan).
                 pub const INDEX_RANGE: rt::ErrorCode = rt::ErrorCode::INDEX_RANGE;
+                /// A hook panicked; the executive caught it and ended the plan.
+                pub const HOOK_PANIC: rt::ErrorCode = rt::ErrorCode::HOOK_PANIC;
                 #(#error_consts)*
             }
 
@@ -503,12 +505,13 @@ pub(crate) fn module(
 
             /// An error code this controller reports.
             #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-            pub enum Error { UnknownCommand, IndexRange, #(#error_variants),* }
+            pub enum Error { UnknownCommand, IndexRange, HookPanic, #(#error_variants),* }
             impl Error {
                 /// The typed error of a runtime code (`None` for no error).
                 pub const fn from_raw(raw: rt::ErrorCode) -> Option<Self> {
                     if raw.0 == error::UNKNOWN_COMMAND.0 { return Some(Self::UnknownCommand); }
                     if raw.0 == error::INDEX_RANGE.0 { return Some(Self::IndexRange); }
+                    if raw.0 == error::HOOK_PANIC.0 { return Some(Self::HookPanic); }
                     #(if raw.0 == error::#error_consts_ids.0 { return Some(Self::#error_variants); })*
                     None
                 }
@@ -517,6 +520,7 @@ pub(crate) fn module(
                     match self {
                         Self::UnknownCommand => error::UNKNOWN_COMMAND,
                         Self::IndexRange => error::INDEX_RANGE,
+                        Self::HookPanic => error::HOOK_PANIC,
                         #(Self::#error_variants => error::#error_consts_ids),*
                     }
                 }
@@ -525,6 +529,7 @@ pub(crate) fn module(
                     match self {
                         Self::UnknownCommand => "UNKNOWN_COMMAND",
                         Self::IndexRange => "INDEX_RANGE",
+                        Self::HookPanic => "HOOK_PANIC",
                         #(Self::#error_variants => #error_names),*
                     }
                 }
@@ -626,6 +631,15 @@ pub(crate) fn module(
                     if self.bk.echo_serial() == 0 { None } else { state_name(self.bk.verb(), self.bk.state()) }
                 }
 
+                /// Step 5: the status, the written buffers and the commands sent
+                /// this cycle (also after a fault, so that the supervisor sees it).
+                fn publish(&mut self, ctx: &rt::CycleContext) {
+                    self.status_out.write(self.bk.status_buffer(), ctx.cycle);
+                    #status_fields_write
+                    #(self.#write_handles.write(self.data.writes.#write_fields, ctx.cycle);)*
+                    #(self.#sub_handles.flush(ctx.cycle);)*
+                }
+
                 #decide
 
                 #(#plan_fns)*
@@ -652,11 +666,16 @@ pub(crate) fn module(
                     #decide_call
                     #post_call
                     #step5
-                    self.status_out.write(self.bk.status_buffer(), ctx.cycle);
-                    #status_fields_write
-                    #(self.#write_handles.write(self.data.writes.#write_fields, ctx.cycle);)*
-                    #(self.#sub_handles.flush(ctx.cycle);)*
+                    self.publish(ctx);
                     #step6
+                    self.bk.end_cycle();
+                }
+
+                fn fault(&mut self, code: rt::ErrorCode, ctx: &rt::CycleContext) {
+                    // The cycle was cut short (a hook panicked): end the plan with
+                    // `code`, then steps 5 and 6 as the cycle would have.
+                    self.bk.fault(code);
+                    self.publish(ctx);
                     self.bk.end_cycle();
                 }
 

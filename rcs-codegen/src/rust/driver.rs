@@ -235,7 +235,16 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
     } else {
         (
             quote!(status),
-            quote!(#(#sub_names => { self.#sub_status.write(status, self.cycle); Ok(()) })*),
+            // An echo without an epoch is in the epoch of the commands sent
+            // (`Driven::write_sub_status`): scenarios name serials only.
+            quote!(#(#sub_names => {
+                let mut status = status;
+                if status.echo_epoch == 0 {
+                    status.echo_epoch = self.#sub_cmd.read().value.epoch;
+                }
+                self.#sub_status.write(status, self.cycle);
+                Ok(())
+            })*),
         )
     };
     let sub_last = if c.subordinates.is_empty() {

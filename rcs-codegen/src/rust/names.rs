@@ -161,12 +161,12 @@ impl Names {
                     error_consts: idents(distinct(
                         c.errors.iter().map(|e| e.name.as_str()),
                         screaming,
-                        &["NONE", "UNKNOWN_COMMAND", "INDEX_RANGE"],
+                        &["NONE", "UNKNOWN_COMMAND", "INDEX_RANGE", "HOOK_PANIC"],
                     )),
                     error_variants: idents(distinct(
                         c.errors.iter().map(|e| e.name.as_str()),
                         camel,
-                        &["UnknownCommand", "IndexRange"],
+                        &["UnknownCommand", "IndexRange", "HookPanic"],
                     )),
                     vars: idents(distinct(c.vars.iter().map(|v| v.name.as_str()), snake, &[])),
                     hooks: idents(distinct(

@@ -282,11 +282,24 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
 
             /// Run `n` cycles as fast as possible on this thread, the
             /// executives interleaved cycle by cycle (tests and simulation).
-            pub fn run_cycles(&mut self, n: u64) {
+            /// A controller that panics is contained (its plan ends with
+            /// `HOOK_PANIC`, the others run on); all `n` cycles run and the
+            /// panics are returned as the error.
+            pub fn run_cycles(&mut self, n: u64) -> Result<(), rt::CycleFault> {
+                let mut fault: Option<rt::CycleFault> = None;
                 for _ in 0..n {
                     for exec in &mut self.executives {
-                        exec.step();
+                        if let Err(f) = exec.step() {
+                            match &mut fault {
+                                Some(first) => first.merge(f),
+                                None => fault = Some(f),
+                            }
+                        }
                     }
+                }
+                match fault {
+                    Some(f) => Err(f),
+                    None => Ok(()),
                 }
             }
         }
@@ -334,7 +347,7 @@ fn system_example(ir: &Ir, names: &Names) -> Vec<String> {
             ));
         }
     }
-    lines.push("system.run_cycles(10);".into());
+    lines.push("system.run_cycles(10)?;".into());
     if let Some((b, _)) = ir
         .buffers
         .iter()

@@ -175,6 +175,12 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
         status: StatusBuffer,
     ) -> Result<(), rcs_runtime::driver::DriveError> {
         let i = self.sub_index(sub)?;
+        let mut status = status;
+        if status.echo_epoch == 0 {
+            // Scenarios name serials only: the echo is in the epoch of this
+            // controller's commands to `sub` (`Driven::write_sub_status`).
+            status.echo_epoch = self.interp.sent_epoch(i);
+        }
         self.interp.write_sub_status(i, status);
         Ok(())
     }

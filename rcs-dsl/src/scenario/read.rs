@@ -499,6 +499,7 @@ impl Resolver<'_> {
                 "none" => None,
                 "UNKNOWN_COMMAND" => Some(rcs_runtime::ErrorCode::UNKNOWN_COMMAND.0),
                 "INDEX_RANGE" => Some(rcs_runtime::ErrorCode::INDEX_RANGE.0),
+                "HOOK_PANIC" => Some(rcs_runtime::ErrorCode::HOOK_PANIC.0),
                 name => {
                     let i = self
                         .c

@@ -97,6 +97,7 @@ pub(super) fn check(
                 None => "none".to_string(),
                 Some(1) => "UNKNOWN_COMMAND".to_string(),
                 Some(n) if n == rcs_runtime::ErrorCode::INDEX_RANGE.0 => "INDEX_RANGE".to_string(),
+                Some(n) if n == rcs_runtime::ErrorCode::HOOK_PANIC.0 => "HOOK_PANIC".to_string(),
                 Some(n) => c
                     .errors
                     .get(usize::from(n).wrapping_sub(2))

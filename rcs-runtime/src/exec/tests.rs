@@ -1,0 +1,204 @@
+//! Unit tests of [`super`] (exec.rs), kept apart to keep that file short.
+
+use super::*;
+
+/// A supervisor with one subordinate that keeps echoing an old serial.
+struct Stuck {
+    link: crate::SubordinateLink,
+}
+
+impl Controller for Stuck {
+    fn name(&self) -> &str {
+        "SUP"
+    }
+    fn cycle(&mut self, ctx: &CycleContext) {
+        let read = crate::gm::Stamped {
+            value: crate::StatusBuffer::default(),
+            generation: ctx.cycle + 1,
+            writer_cycle: ctx.cycle,
+        };
+        self.link.observe(&read);
+    }
+    fn old_echoes(&self, f: &mut dyn FnMut(&str, u64)) {
+        f("SUB", self.link.old_echoes());
+    }
+}
+
+#[test]
+fn the_timing_report_gives_each_subordinates_old_echoes() -> Result<(), Box<dyn std::error::Error>>
+{
+    let mut link = crate::SubordinateLink::new();
+    link.next_command();
+    let mut e = Executive::new(ExecutiveConfig::new("cpu", Duration::from_millis(1)))?;
+    e.add(Box::new(Stuck { link }))?;
+    e.run_cycles(5)?;
+    assert_eq!(e.old_echoes("SUP"), vec![("SUB".to_string(), 5)]);
+    assert!(e.old_echoes("NOBODY").is_empty());
+    Ok(())
+}
+
+#[test]
+fn a_period_past_the_bound_is_refused_at_construction() {
+    let e = Executive::new(ExecutiveConfig::new("cpu", Duration::MAX));
+    assert!(matches!(e, Err(SetupError::PeriodTooLong(..))), "{e:?}");
+    assert!(Executive::new(ExecutiveConfig::new("cpu", MAX_PERIOD)).is_ok());
+    let e = Executive::new(ExecutiveConfig::new("cpu", Duration::ZERO));
+    assert!(matches!(e, Err(SetupError::ZeroPeriod(..))), "{e:?}");
+}
+
+#[test]
+fn cycle_context_tick() {
+    let now = Instant::now();
+    let ctx = CycleContext {
+        cycle: 4,
+        now,
+        period: Duration::from_millis(1),
+    };
+    assert_eq!(ctx.tick(), Tick { cycle: 4, now });
+}
+
+struct Counter(u64);
+impl Controller for Counter {
+    fn name(&self) -> &str {
+        "count"
+    }
+    fn cycle(&mut self, _: &CycleContext) {
+        self.0 += 1;
+    }
+}
+struct Other;
+impl Controller for Other {
+    fn name(&self) -> &str {
+        "other"
+    }
+    fn cycle(&mut self, _: &CycleContext) {}
+}
+
+#[test]
+fn a_controller_comes_back_as_its_own_type() -> Result<(), Box<dyn std::error::Error>> {
+    let mut exec = Executive::new(ExecutiveConfig::new("x", Duration::from_millis(1)))?;
+    exec.add(Box::new(Counter(0)))?;
+    exec.add(Box::new(Other))?;
+    exec.run_cycles(3)?;
+    assert_eq!(exec.controller_as::<Counter>("count").map(|c| c.0), Some(3));
+    assert!(exec.controller_as::<Other>("count").is_none());
+    assert!(exec.controller_as::<Counter>("nobody").is_none());
+    if let Some(c) = exec.controller_as_mut::<Counter>("count") {
+        c.0 = 10;
+    }
+    exec.step()?;
+    assert_eq!(
+        exec.controller_as::<Counter>("count").map(|c| c.0),
+        Some(11)
+    );
+    Ok(())
+}
+
+/// A controller whose cycle panics while `panic` is set; `fault` records
+/// the code it was given.
+struct Fragile {
+    name: &'static str,
+    panic: bool,
+    cycles: u64,
+    faults: Vec<ErrorCode>,
+}
+
+impl Controller for Fragile {
+    fn name(&self) -> &str {
+        self.name
+    }
+    fn cycle(&mut self, _: &CycleContext) {
+        assert!(!self.panic, "hook {} failed", self.name);
+        self.cycles += 1;
+    }
+    fn fault(&mut self, code: ErrorCode, _: &CycleContext) {
+        self.faults.push(code);
+    }
+}
+
+fn fragile(name: &'static str, panic: bool) -> Box<Fragile> {
+    Box::new(Fragile {
+        name,
+        panic,
+        cycles: 0,
+        faults: Vec::new(),
+    })
+}
+
+#[test]
+fn a_panicking_controller_is_contained_and_reported() -> Result<(), SetupError> {
+    let mut e = Executive::new(ExecutiveConfig::new("cpu", Duration::from_millis(1)))?;
+    e.add(fragile("A", false))?;
+    e.add(fragile("BAD", true))?;
+    e.add(fragile("C", false))?;
+    let fault = e.run_cycles(3).expect_err("BAD panics");
+    assert_eq!(fault.total, 3);
+    assert!(fault.panics.iter().all(|p| p.executive == "cpu"));
+    assert_eq!(
+        fault
+            .panics
+            .iter()
+            .map(|p| (p.controller.as_str(), p.cycle))
+            .collect::<Vec<_>>(),
+        vec![("BAD", 0), ("BAD", 1), ("BAD", 2)]
+    );
+    assert_eq!(fault.panics[0].message, "hook BAD failed");
+    assert!(
+        fault.to_string().starts_with(
+            "controller `BAD` (executive `cpu`) panicked in cycle 0: hook BAD failed;"
+        ),
+        "{fault}"
+    );
+    // The others ran every cycle, after the panic too.
+    for name in ["A", "C"] {
+        assert_eq!(e.controller_as::<Fragile>(name).map(|c| c.cycles), Some(3));
+    }
+    let bad = e.controller_as::<Fragile>("BAD").map(|c| c.faults.clone());
+    assert_eq!(bad, Some(vec![ErrorCode::HOOK_PANIC; 3]));
+    assert_eq!(e.controller_stats("BAD").map(|s| s.panics), Some(3));
+    assert_eq!(e.controller_stats("A").map(|s| s.panics), Some(0));
+    assert_eq!(e.last_panic("BAD"), Some("hook BAD failed"));
+    assert_eq!(e.last_panic("A"), None);
+    assert_eq!(e.cycle(), 3);
+    // Mended, it runs again, and the next call reports nothing old.
+    if let Some(c) = e.controller_as_mut::<Fragile>("BAD") {
+        c.panic = false;
+    }
+    assert_eq!(e.step(), Ok(()));
+    assert_eq!(e.controller_as::<Fragile>("BAD").map(|c| c.cycles), Some(1));
+    Ok(())
+}
+
+#[test]
+fn a_fault_lists_the_first_panics_and_counts_the_rest() -> Result<(), SetupError> {
+    let mut e = Executive::new(ExecutiveConfig::new("cpu", Duration::from_millis(1)))?;
+    e.add(fragile("BAD", true))?;
+    let fault = e.run_cycles(100).expect_err("BAD panics");
+    assert_eq!(fault.total, 100);
+    assert_eq!(fault.panics.len(), CycleFault::LISTED);
+    assert!(
+        fault.to_string().ends_with("(and 84 more panics)"),
+        "{fault}"
+    );
+    // Two executives' faults merge within the bound.
+    let mut first = fault.clone();
+    first.merge(fault);
+    assert_eq!((first.total, first.panics.len()), (200, CycleFault::LISTED));
+    Ok(())
+}
+
+#[test]
+fn on_the_heartbeat_a_panic_lives_on_in_the_statistics() -> Result<(), SetupError> {
+    let mut e = Executive::new(ExecutiveConfig::new("cpu", Duration::from_micros(100)))?;
+    e.add(fragile("BAD", true))?;
+    e.add(fragile("OK", false))?;
+    e.run_for(5);
+    assert_eq!(e.controller_stats("BAD").map(|s| s.panics), Some(5));
+    assert_eq!(e.controller_as::<Fragile>("OK").map(|c| c.cycles), Some(5));
+    // Nothing left over for the next step to report.
+    if let Some(c) = e.controller_as_mut::<Fragile>("BAD") {
+        c.panic = false;
+    }
+    assert_eq!(e.step(), Ok(()));
+    Ok(())
+}

@@ -14,7 +14,10 @@
 //! correct without synchronising their cycles (§5.5).
 //!
 //! Nothing here allocates or locks once the controllers are added, unless a
-//! trace sink is attached ([`Executive::set_trace`]).
+//! trace sink is attached ([`Executive::set_trace`]). A [`CycleSignal`]
+//! attached with [`Executive::set_cycle_signal`] is raised at the end of
+//! every cycle (lock- and allocation-free): the Zenoh bridge publishes the
+//! cycle's writes then instead of polling for them.
 
 use std::any::Any;
 use std::io;
@@ -25,6 +28,7 @@ use std::time::{Duration, Instant};
 
 use crate::error::SetupError;
 use crate::plan::{Bookkeeping, SampleStats, Tick};
+use crate::signal::CycleSignal;
 use crate::trace::{TraceRecord, TraceSink};
 
 /// What the executive tells a controller about the cycle it runs in.
@@ -330,6 +334,7 @@ pub struct Executive {
     stats: ExecutiveStats,
     shared: Arc<Shared>,
     trace: Option<TraceSink>,
+    signal: Option<CycleSignal>,
 }
 
 impl std::fmt::Debug for Executive {
@@ -367,6 +372,7 @@ impl Executive {
             stats: ExecutiveStats::default(),
             shared: Arc::default(),
             trace: None,
+            signal: None,
         })
     }
 
@@ -390,6 +396,20 @@ impl Executive {
     /// for debugging and replay, not for production timing.
     pub fn set_trace(&mut self, sink: TraceSink) {
         self.trace = Some(sink);
+    }
+
+    /// Raise `signal` at the end of every cycle, once all controllers have
+    /// written (the generated `System::process` attaches its bridge's
+    /// `Bridge::signal()` to each executive, feature `zenoh`, so that the
+    /// cycle's writes are published at once). Replaces an earlier one.
+    /// Raising takes no lock and allocates nothing.
+    pub fn set_cycle_signal(&mut self, signal: CycleSignal) {
+        self.signal = Some(signal);
+    }
+
+    /// Detach and return the cycle signal.
+    pub fn take_cycle_signal(&mut self) -> Option<CycleSignal> {
+        self.signal.take()
     }
 
     /// Detach and return the trace sink.
@@ -523,6 +543,9 @@ impl Executive {
         self.cycle = cycle.wrapping_add(1);
         self.stats.cycles = self.cycle;
         self.shared.cycle.store(self.cycle, Ordering::Release);
+        if let Some(signal) = &self.signal {
+            signal.raise();
+        }
     }
 
     /// This executive's name.
@@ -713,6 +736,25 @@ mod tests {
             "other"
         }
         fn cycle(&mut self, _: &CycleContext) {}
+    }
+
+    #[test]
+    fn every_cycle_raises_the_attached_signal() -> Result<(), SetupError> {
+        let mut exec = Executive::new(ExecutiveConfig::new("x", Duration::from_millis(1)))?;
+        exec.add(Box::new(Counter(0)))?;
+        let signal = CycleSignal::new();
+        exec.step();
+        assert!(!signal.take(), "not attached yet");
+        exec.set_cycle_signal(signal.clone());
+        exec.step();
+        assert!(signal.take());
+        assert!(!signal.take());
+        exec.run_cycles(3);
+        assert!(signal.take());
+        assert!(exec.take_cycle_signal().is_some());
+        exec.step();
+        assert!(!signal.take(), "detached");
+        Ok(())
     }
 
     #[test]

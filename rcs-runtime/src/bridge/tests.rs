@@ -11,10 +11,10 @@ use crate::schema::{combine, Schema};
 use crate::SetupError;
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-struct Ship {
-    speed: f64,
-    ahead: bool,
-    count: u64,
+pub(super) struct Ship {
+    pub(super) speed: f64,
+    pub(super) ahead: bool,
+    pub(super) count: u64,
 }
 
 impl Schema for Ship {

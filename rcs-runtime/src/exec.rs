@@ -25,6 +25,9 @@
 //!
 //! Nothing here allocates or locks once the controllers are added, unless a
 //! trace sink is attached ([`Executive::set_trace`]) or a controller panics.
+//! A [`CycleSignal`] attached with [`Executive::set_cycle_signal`] is raised
+//! at the end of every cycle (lock- and allocation-free): the Zenoh bridge
+//! publishes the cycle's writes then instead of polling for them.
 
 use std::any::Any;
 use std::io;
@@ -39,6 +42,7 @@ use crate::fault::{panic_message, ControllerPanic, CycleFault};
 use crate::handshake::ErrorCode;
 pub use crate::heartbeat::{Heartbeat, Wait, MAX_PERIOD};
 use crate::plan::{Bookkeeping, SampleStats, Tick};
+use crate::signal::CycleSignal;
 use crate::trace::{TraceRecord, TraceSink};
 
 /// What the executive tells a controller about the cycle it runs in.
@@ -256,6 +260,7 @@ pub struct Executive {
     trace: Option<TraceSink>,
     /// Panics caught since the last `step`/`run_cycles` reported them.
     fault: Option<CycleFault>,
+    signal: Option<CycleSignal>,
 }
 
 impl std::fmt::Debug for Executive {
@@ -294,6 +299,7 @@ impl Executive {
             shared: Arc::default(),
             trace: None,
             fault: None,
+            signal: None,
         })
     }
 
@@ -318,6 +324,20 @@ impl Executive {
     /// for debugging and replay, not for production timing.
     pub fn set_trace(&mut self, sink: TraceSink) {
         self.trace = Some(sink);
+    }
+
+    /// Raise `signal` at the end of every cycle, once all controllers have
+    /// written (the generated `System::process` attaches its bridge's
+    /// `Bridge::signal()` to each executive, feature `zenoh`, so that the
+    /// cycle's writes are published at once). Replaces an earlier one.
+    /// Raising takes no lock and allocates nothing.
+    pub fn set_cycle_signal(&mut self, signal: CycleSignal) {
+        self.signal = Some(signal);
+    }
+
+    /// Detach and return the cycle signal.
+    pub fn take_cycle_signal(&mut self) -> Option<CycleSignal> {
+        self.signal.take()
     }
 
     /// Detach and return the trace sink.
@@ -487,6 +507,9 @@ impl Executive {
         self.cycle = cycle.wrapping_add(1);
         self.stats.cycles = self.cycle;
         self.shared.cycle.store(self.cycle, Ordering::Release);
+        if let Some(signal) = &self.signal {
+            signal.raise();
+        }
     }
 
     /// This executive's name.

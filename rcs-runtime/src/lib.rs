@@ -18,6 +18,8 @@
 //! | [`operator`] | [`Operator`]: command a root controller, read status |
 //! | [`trace`] | optional JSON-lines trace of every controller's cycle |
 //! | [`schema`] | [`Schema`]: a stable hash of a buffer type's structure |
+//! | [`serde_array`] | serde for arrays of any length (serde itself stops at 32), for generated types |
+//! | [`signal`] | [`CycleSignal`]: an executive wakes a thread off the cycle path (the bridge's export) |
 //! | `bridge` | (feature `zenoh`) Global Memory across processes over Zenoh |
 //! | `acl` | (features `zenoh`, `certs`) identities for the bridge: mutual TLS, the opt-out, development certificates |
 //! | `seqlock` | the only `unsafe` code: the sequence lock behind Global Memory |
@@ -199,6 +201,8 @@ pub mod operator;
 pub mod plan;
 pub mod schema;
 mod seqlock;
+pub mod serde_array;
+pub mod signal;
 pub mod trace;
 
 #[cfg(any(feature = "zenoh", feature = "certs"))]
@@ -227,6 +231,7 @@ pub use schema::Schema;
 /// types of multi-process plan sets (their crates need not depend on serde).
 #[doc(hidden)]
 pub use serde;
+pub use signal::CycleSignal;
 pub use trace::{read_trace, TraceError, TraceHeader, TraceRecord, TraceSink, TRACE_VERSION};
 
 /// Include the Rust code `rcsc` generated for a plan set from a build script.

@@ -10,11 +10,14 @@ mod common;
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Barrier};
 use std::time::Duration;
 
 use common::{Relay, GO, HOLD};
-use rcs_runtime::{Executive, ExecutiveConfig, GlobalMemory, Operator, Status, VerbId};
+use rcs_runtime::{
+    CycleSignal, Executive, ExecutiveConfig, GlobalMemory, Operator, Status, VerbId,
+};
 
 struct Counting;
 
@@ -108,6 +111,22 @@ fn ten_thousand_cycles_allocate_nothing() {
         .unwrap();
     let mut op = Operator::<VerbId>::connect(&gm, "SM").unwrap();
     let handle = exec.handle();
+    // A cycle signal with a thread waiting on it, as the bridge's export
+    // thread does: every cycle raises it, and wakes the waiter whenever it
+    // has taken the last raise.
+    let signal = CycleSignal::new();
+    exec.set_cycle_signal(signal.clone());
+    let stop = Arc::new(AtomicBool::new(false));
+    let waiter = {
+        let (signal, stop) = (signal.clone(), Arc::clone(&stop));
+        std::thread::spawn(move || {
+            let mut woken = 0u64;
+            while !stop.load(Ordering::Acquire) {
+                woken += u64::from(signal.wait(Duration::from_millis(100)));
+            }
+            woken
+        })
+    };
     // Warm up once (first-touch effects, lazily initialised statics).
     op.command(GO);
     exec.run_cycles(10).unwrap();
@@ -128,6 +147,10 @@ fn ten_thousand_cycles_allocate_nothing() {
         done
     });
 
+    stop.store(true, Ordering::Release);
+    signal.raise();
+    let woken = waiter.join().expect("the waiting thread");
+    assert!(woken >= 1, "the signal never woke its waiter");
     assert_eq!(exec.cycle(), 10 + 10_000);
     assert!(done >= 60, "commands completed: {done}");
     assert_eq!(allocations, 0, "heap allocations on the cycle path");
@@ -135,13 +158,12 @@ fn ten_thousand_cycles_allocate_nothing() {
 
 /// The same hierarchy split over two Global Memories joined by Zenoh
 /// bridges (TB in "process" B, on a thread of its own): the cycles of SM
-/// and PR still allocate nothing while the bridges carry TB's command and
-/// status back and forth.
+/// and PR, which raise their bridge's cycle signal, still allocate nothing
+/// while the bridges carry TB's command and status back and forth.
 #[cfg(feature = "zenoh")]
 #[test]
 fn cycles_allocate_nothing_with_the_bridge_running() {
     use rcs_runtime::{Bridge, BridgeConfig, CommandBuffer, StatusBuffer};
-    use std::sync::atomic::{AtomicBool, Ordering};
     use std::time::Instant;
 
     let port = std::net::TcpListener::bind("127.0.0.1:0")
@@ -177,7 +199,12 @@ fn cycles_allocate_nothing_with_the_bridge_running() {
     b.import::<CommandBuffer<VerbId>>("TB.command", "helm")
         .unwrap();
     b.export::<StatusBuffer>("TB.status").unwrap();
-    let _b = b.start().unwrap();
+    let b = b.start().unwrap();
+    // Each executive raises its bridge's signal after every cycle, as the
+    // generated `System::process` sets them up: the measured cycles below
+    // include the raise.
+    exec.set_cycle_signal(a.signal());
+    engine.set_cycle_signal(b.signal());
     let stop = Arc::new(AtomicBool::new(false));
     let engine_thread = {
         let stop = Arc::clone(&stop);

@@ -448,6 +448,7 @@ fn engine(opts: &Options) -> Result<bool, String> {
             .map_err(|e| e.to_string())?;
         watch.watch(&name, reader);
     }
+    let inputs_written = bridge.signal();
     println!("engine: running");
     let mut heartbeat = Heartbeat::new(period, Wait::default()).map_err(|e| e.to_string())?;
     let mut last = String::new();
@@ -462,6 +463,9 @@ fn engine(opts: &Options) -> Result<bool, String> {
         plant.step(system.outputs.drive.read().value, dt);
         ship.write(plant.ship(), cycle + 1);
         turbine.write(plant.turbine(), cycle + 1);
+        // Written outside an executive: publish them now rather than with
+        // the next cycle's signal or the bridge's fallback poll.
+        inputs_written.raise();
         let now = statuses(&system);
         if now != last {
             println!("cycle {cycle} {now}");

@@ -108,7 +108,15 @@ pub(crate) fn module(
                 let ps = &n.params[i];
                 let tys = k.params.iter().map(|p| rust_type(names, &p.ty));
                 let pdocs = k.params.iter().map(|p| docs(&p.docs));
-                quote!(#d #default #v { #(#pdocs #ps: #tys),* })
+                // Only a distributed set's commands derive serde.
+                let withs = k.params.iter().map(|p| {
+                    if names.wire {
+                        super::types::serde_with(names, &p.ty, None)
+                    } else {
+                        quote!()
+                    }
+                });
+                quote!(#d #default #v { #(#pdocs #withs #ps: #tys),* })
             }
         });
         let arms = c.commands.iter().enumerate().map(|(i, k)| {

@@ -88,6 +88,19 @@ pub(crate) fn parts(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments) 
             c.name, c.name
         );
         let wire = super::schema::derives(names);
+        // Only a distributed set's status fields derive serde.
+        let docs: Vec<TokenStream> = own
+            .iter()
+            .zip(docs)
+            .map(|((_, v), d)| {
+                if names.wire {
+                    let with = super::types::serde_with(names, &v.ty, None);
+                    quote!(#d #with)
+                } else {
+                    d
+                }
+            })
+            .collect();
         let structure = format!(
             "status_fields {}{{{}}}",
             c.name,

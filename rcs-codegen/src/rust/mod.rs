@@ -76,14 +76,19 @@ pub fn system_module(ir: &Ir, options: &crate::Options) -> String {
     // A distributed set's types travel over the bridge: serde through the
     // runtime's re-export, whatever `options.serde` says.
     let serde = match &options.serde {
-        _ if names.wire => Some(schema::derives(&names)),
+        _ if names.wire => Some(types::SerdeDerive {
+            attrs: schema::derives(&names),
+            feature: None,
+        }),
         crate::SerdeDerives::Off => None,
-        crate::SerdeDerives::Always => {
-            Some(quote!(#[derive(::serde::Serialize, ::serde::Deserialize)]))
-        }
-        crate::SerdeDerives::Feature(name) => Some(
-            quote!(#[cfg_attr(feature = #name, derive(::serde::Serialize, ::serde::Deserialize))]),
-        ),
+        crate::SerdeDerives::Always => Some(types::SerdeDerive {
+            attrs: quote!(#[derive(::serde::Serialize, ::serde::Deserialize)]),
+            feature: None,
+        }),
+        crate::SerdeDerives::Feature(name) => Some(types::SerdeDerive {
+            attrs: quote!(#[cfg_attr(feature = #name, derive(::serde::Serialize, ::serde::Deserialize))]),
+            feature: Some(name.clone()),
+        }),
     };
     let types = types::module(ir, &names, serde.as_ref(), conversions);
     let controllers: Vec<TokenStream> = (0..ir.controllers.len())
@@ -158,7 +163,7 @@ mod tests {
             "t",
             [(
                 "t.rcs",
-                "enum Mode { Off, On }\nbuffer Small { m: Mode, xs: [u8; 32] }\nbuffer Big { xs: [u8; 33] }\n\
+                "enum Mode { Off, On }\nbuffer Small { m: Mode, xs: [u8; 32] }\nbuffer Big { xs: [u8; 33], grid: [[u8; 40]; 3] }\n\
                  controller A {\n    reads small: Small\n    reads big: Big\n    command GO\n    plan GO {\n        \
                  *0 when new_command && small.m == Mode::On && big.xs[0] == small.xs[0] -> Done\n    }\n}\n",
             )],
@@ -186,7 +191,7 @@ mod tests {
     }
 
     #[test]
-    fn serde_derives_follow_the_option_and_skip_arrays_serde_cannot_derive() {
+    fn serde_derives_follow_the_option_and_long_arrays_go_through_serde_array() {
         let off = rust(&Options::default());
         assert!(!off.contains("serde"));
 
@@ -197,9 +202,24 @@ mod tests {
         let derive = "#[derive(::serde::Serialize, ::serde::Deserialize)]";
         assert!(attrs_of(&always, "pub enum Mode").contains(&derive.to_string()));
         assert!(attrs_of(&always, "pub struct Small").contains(&derive.to_string()));
-        assert!(!attrs_of(&always, "pub struct Big")
-            .iter()
-            .any(|a| a.contains("serde")));
+        assert!(attrs_of(&always, "pub struct Big").contains(&derive.to_string()));
+        // Arrays serde handles itself get no attribute; longer ones (or
+        // arrays of them) a codec of `rcs_runtime::serde_array`.
+        // Arrays serde handles itself get no attribute; longer ones (or
+        // arrays of them) a codec of `rcs_runtime::serde_array`. Compared
+        // without whitespace: rustfmt breaks long attributes.
+        let squeeze = |t: &str| t.split_whitespace().collect::<String>();
+        let always = squeeze(&always);
+        assert!(always.contains("{pubm:super::types::Mode,pubxs:[u8;32],}"));
+        let leaf = "::rcs_runtime::serde_array::Leaf<u8>";
+        let long = format!(
+            r#"#[serde(with="::rcs_runtime::serde_array::Array::<{leaf},33>")]pubxs:[u8;33],"#
+        );
+        assert!(always.contains(&long), "{always}");
+        let nested = format!(
+            r#"#[serde(with="::rcs_runtime::serde_array::Array::<::rcs_runtime::serde_array::Array<{leaf},40>,3>")]pubgrid:[[u8;40];3],"#
+        );
+        assert!(always.contains(&nested), "{always}");
 
         let feature = rust(&Options {
             serde: SerdeDerives::Feature("wire".into()),
@@ -209,6 +229,11 @@ mod tests {
             &"#[cfg_attr(feature = \"wire\", derive(::serde::Serialize, ::serde::Deserialize))]"
                 .to_string()
         ));
+        // The field's attribute sits behind the same feature as the derive.
+        let gated = format!(
+            r#"#[cfg_attr(feature="wire",serde(with="::rcs_runtime::serde_array::Array::<{leaf},33>"))]pubxs:[u8;33],"#
+        );
+        assert!(squeeze(&feature).contains(&gated), "{feature}");
     }
 
     #[test]

@@ -4,8 +4,11 @@
 //! (`rcs_runtime::Bridge`, feature `zenoh` of the user's `rcs-runtime`)
 //! exporting the buffers this process writes and others read, importing
 //! those others write and this process reads. Which buffers cross comes
-//! from `rcs_dsl::placement`. Nothing here is emitted for a single-process
-//! set: its code does not mention Zenoh, so it builds without the feature.
+//! from `rcs_dsl::placement`. Every executive of the process gets the
+//! bridge's cycle signal, so a cycle's writes are published when the cycle
+//! ends rather than when a poll comes by. Nothing here is emitted for a
+//! single-process set: its code does not mention Zenoh, so it builds
+//! without the feature.
 
 use proc_macro2::TokenStream;
 use quote::quote;
@@ -122,27 +125,8 @@ pub(crate) fn process_api(
                     bridge.export::<rt::StatusBuffer>(&rt::status_buffer_name(#m::NAME))?;
                 }
             });
-        // The bridge polls at the pace of the fastest CPU elsewhere that
-        // reads what this process writes (1 ms if none).
-        let poll = placement
-            .crossings
-            .iter()
-            .filter(|x| x.writer == p)
-            .flat_map(|x| &x.readers)
-            .flat_map(|r| {
-                ir.schedule
-                    .iter()
-                    .zip(&placement.cpu_process)
-                    .filter(move |(_, cp)| *cp == r)
-                    .map(|(cpu, _)| cpu.period_ns)
-            })
-            .min()
-            .unwrap_or(1_000_000);
         quote! {
             #process => {
-                if config.poll_period.is_none() {
-                    config.poll_period = Some(::core::time::Duration::from_nanos(#poll));
-                }
                 if config.policy.is_none() {
                     config.policy = Some(#policy.to_owned());
                 }
@@ -243,8 +227,11 @@ pub(crate) fn process_api(
             /// `zenoh`. `inputs` holds the writers of the external inputs
             /// this process writes (`inputs:` in the manifest), `None` for
             /// the others; `operators` command roots that run here.
-            /// `config.poll_period`, when `None`, becomes the period of the
-            /// fastest CPU elsewhere that reads a buffer written here;
+            /// Every executive raises the bridge's signal after each cycle,
+            /// so the buffers it wrote leave at once; inputs written outside
+            /// the executives leave with the next cycle, the bridge's
+            /// fallback poll (`config.poll_period`), or at once if the
+            /// writer raises `bridge.signal()`.
             /// `config.policy`, when `None`, becomes this process's
             /// access-control policy generated from the plan set (it applies
             /// under `config.security = Security::Tls`, which
@@ -269,6 +256,9 @@ pub(crate) fn process_api(
                         })
                     }
                 };
+                for exec in &mut executives {
+                    exec.set_cycle_signal(bridge.signal());
+                }
                 let system = Self {
                     inputs: Inputs { #(#inputs),* },
                     outputs: #outputs,

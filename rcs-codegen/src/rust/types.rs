@@ -13,27 +13,70 @@ fn docs(lines: &[String]) -> TokenStream {
     quote!(#(#[doc = #lines])*)
 }
 
-/// Whether serde can derive for a type: it implements arrays only up to 32.
-fn serde_derivable(ir: &Ir, t: &Type, depth: u32) -> bool {
+/// Whether serde handles a type itself: it implements arrays only up to 32
+/// long. (Every generated buffer type serialises, see [`serde_with`].)
+fn serde_native(t: &Type) -> bool {
     match t {
-        Type::Array(elem, n) => *n <= 32 && serde_derivable(ir, elem, depth),
-        Type::Buffer(b) => {
-            depth < 64
-                && ir.buffer_types[b.index()]
-                    .fields
-                    .iter()
-                    .all(|f| serde_derivable(ir, &f.ty, depth + 1))
-        }
+        Type::Array(elem, n) => *n <= 32 && serde_native(elem),
         _ => true,
     }
 }
 
-/// `serde`: the serde derive attribute, if asked for. `extra`: more items
-/// for the module (the driver's conversions).
+/// The `rcs_runtime::serde_array` codec of `t`, as the text of a type in
+/// generic-argument position.
+fn codec(names: &Names, t: &Type) -> String {
+    match t {
+        Type::Array(elem, n) if !serde_native(t) => {
+            format!(
+                "::rcs_runtime::serde_array::Array<{}, {n}>",
+                codec(names, elem)
+            )
+        }
+        _ => {
+            let ty = rust_type(names, t).to_string().replace(' ', "");
+            format!("::rcs_runtime::serde_array::Leaf<{ty}>")
+        }
+    }
+}
+
+/// The serde attribute of a field (or command parameter) of type `t`:
+/// nothing where serde handles the type itself, else
+/// `#[serde(with = "::rcs_runtime::serde_array::Array::<…>")]` (an array
+/// longer than 32, or holding one), behind `cfg_attr(feature = …)` when
+/// the derives are. Plan sets without such arrays get the same code as
+/// before.
+pub(crate) fn serde_with(names: &Names, t: &Type, feature: Option<&str>) -> TokenStream {
+    let Type::Array(elem, n) = t else {
+        return quote!();
+    };
+    if serde_native(t) {
+        return quote!();
+    }
+    let with = format!(
+        "::rcs_runtime::serde_array::Array::<{}, {n}>",
+        codec(names, elem)
+    );
+    match feature {
+        Some(f) => quote!(#[cfg_attr(feature = #f, serde(with = #with))]),
+        None => quote!(#[serde(with = #with)]),
+    }
+}
+
+/// How generated types derive serde, if they do.
+pub(crate) struct SerdeDerive {
+    /// The derive (and crate) attributes of each type.
+    pub attrs: TokenStream,
+    /// `Some(name)`: the derives sit behind `cfg_attr(feature = name)`, and
+    /// so must the fields' `serde(with)`.
+    pub feature: Option<String>,
+}
+
+/// `serde`: the serde derives, if asked for. `extra`: more items for the
+/// module (the driver's conversions).
 pub(crate) fn module(
     ir: &Ir,
     names: &Names,
-    serde: Option<&TokenStream>,
+    serde: Option<&SerdeDerive>,
     extra: TokenStream,
 ) -> TokenStream {
     let enums = ir.enums.iter().enumerate().map(|(i, e)| {
@@ -52,7 +95,7 @@ pub(crate) fn module(
         });
         let ids = &n.variants;
         let texts: Vec<&str> = e.variants.iter().map(|v| v.name.as_str()).collect();
-        let serde = serde.into_iter();
+        let serde = serde.map(|s| &s.attrs).into_iter();
         let schema = super::schema::schema_impl(
             names,
             &quote!(#ty),
@@ -96,10 +139,17 @@ pub(crate) fn module(
                 },
             )
         };
-        // A buffer serde cannot derive for (an array over 32) goes without.
-        let serde = serde
-            .filter(|_| serde_derivable(ir, &Type::Buffer(rcs_dsl::ir::BufferTypeId(i as u32)), 0))
-            .into_iter();
+        // A field serde cannot handle itself (an array over 32) goes
+        // through `rcs_runtime::serde_array`.
+        let withs: Vec<TokenStream> = match serde {
+            Some(s) => b
+                .fields
+                .iter()
+                .map(|f| serde_with(names, &f.ty, s.feature.as_deref()))
+                .collect(),
+            None => b.fields.iter().map(|_| quote!()).collect(),
+        };
+        let serde = serde.map(|s| &s.attrs).into_iter();
         let structure = format!(
             "buffer {}{{{}}}",
             b.name,
@@ -115,7 +165,7 @@ pub(crate) fn module(
             #d
             #(#serde)*
             #[derive(Clone, Copy, Debug, #derive PartialEq)]
-            pub struct #ty { #(#fdocs pub #fields: #tys),* }
+            pub struct #ty { #(#fdocs #withs pub #fields: #tys),* }
             #default_impl
             #schema
         }

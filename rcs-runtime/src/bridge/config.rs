@@ -29,10 +29,11 @@ pub struct BridgeConfig {
     /// Find peers by UDP multicast scouting as well (off: explicit
     /// endpoints only, which is what tests and most plants want).
     pub multicast_scouting: bool,
-    /// How often the bridge thread looks for new writes of exported
-    /// buffers. `None`: the generated `System::process` puts the period of
-    /// the fastest CPU in another process that reads one; a bridge started
-    /// with `None` polls every 1 ms.
+    /// The fallback poll: how often the export thread looks for writes
+    /// of exported buffers that nobody signalled. Writes followed by a
+    /// raise of [`Bridge::signal`](super::Bridge::signal) (every executive
+    /// of a generated `System::process` raises it after each cycle) are
+    /// published at once, whatever this says. `None`: every 10 ms.
     pub poll_period: Option<Duration>,
     /// How often every exported buffer is published again even if
     /// unchanged, for processes that join late or restart.

@@ -12,10 +12,16 @@
 //! * **Samples**: postcard of `(schema, generation, writer_cycle, value)`:
 //!   the [`Schema::SCHEMA`] of the buffer type, then the writer's stamps,
 //!   then the value ([`wire`]).
-//! * **Export** (local writer → Zenoh): one bridge thread polls the exported
-//!   cells' generation every [`BridgeConfig::poll_period`] and publishes a
-//!   buffer only when its generation changed, plus every buffer again every
-//!   [`BridgeConfig::resend_period`] so that a process that joins late (or
+//! * **Export** (local writer → Zenoh): one bridge thread publishes a
+//!   buffer when its generation changed. It sleeps until woken: by the
+//!   bridge's [`CycleSignal`] ([`Bridge::signal`]), which every executive
+//!   of a generated `System::process` raises at the end of each cycle
+//!   ([`Executive::set_cycle_signal`](crate::Executive::set_cycle_signal)),
+//!   so a cycle's writes leave at once; by the *fallback poll* every
+//!   [`BridgeConfig::poll_period`] (10 ms by default), for writes nobody
+//!   signalled (a main loop writing inputs can raise the signal itself);
+//!   and by the *resend* every [`BridgeConfig::resend_period`], which
+//!   publishes every buffer again so that a process that joins late (or
 //!   restarts) gets the latest values. Publishers use
 //!   `CongestionControl::Drop`: a value the network cannot take now is
 //!   dropped, never queued behind newer ones (commands are not queued,
@@ -31,7 +37,8 @@
 //!   [`BridgeError::SchemaMismatch`].
 //!
 //! The cycle path is untouched: an executive's reads and writes stay
-//! lock-free, allocation-free seqlock copies; decoding, encoding and Zenoh
+//! lock-free, allocation-free seqlock copies, and raising the signal is an
+//! atomic swap plus, at most, one futex wake; decoding, encoding and Zenoh
 //! itself run on the bridge's and Zenoh's threads.
 
 mod config;
@@ -41,12 +48,13 @@ mod import;
 mod wire;
 
 #[cfg(test)]
+mod event_tests;
+#[cfg(test)]
 mod tests;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
-use std::time::Duration;
 
 use serde::de::DeserializeOwned;
 use serde::Serialize;
@@ -57,11 +65,12 @@ use zenoh::{Session, Wait};
 use crate::acl::Security;
 use crate::gm::{BufferData, GlobalMemory};
 use crate::schema::Schema;
+use crate::signal::CycleSignal;
 
 pub use config::BridgeConfig;
 pub use error::{BridgeError, BridgeStats, Refusal};
 use error::{Counters, ErrorLog};
-use export::{export_loop, Export, ExportSlot};
+use export::{export_loop, Export, ExportSlot, Pacing, DEFAULT_FALLBACK_POLL};
 pub use import::Check;
 use import::{any_value, Import, Sink};
 
@@ -194,7 +203,8 @@ impl<'a> BridgeBuilder<'a> {
     }
 
     /// Open the Zenoh session, declare the subscribers and publishers, and
-    /// start the export thread.
+    /// start the export thread. Attach [`Bridge::signal`] to the executives
+    /// that write exported buffers.
     pub fn start(self) -> Result<Bridge, BridgeError> {
         let zenoh_config = self.config.zenoh_config()?;
         if self.config.security == Security::Insecure {
@@ -233,21 +243,26 @@ impl<'a> BridgeBuilder<'a> {
             exports.push((publisher, slot));
         }
         let stop = Arc::new(AtomicBool::new(false));
+        let signal = CycleSignal::new();
         let exporter = {
             let stop = Arc::clone(&stop);
+            let signal = signal.clone();
             let counters = Arc::clone(&shared.counters);
-            let poll = self.config.poll_period.unwrap_or(Duration::from_millis(1));
-            let resend = self.config.resend_period;
+            let pacing = Pacing {
+                fallback_poll: self.config.poll_period.unwrap_or(DEFAULT_FALLBACK_POLL),
+                resend: self.config.resend_period,
+            };
             std::thread::Builder::new()
                 .name(format!("rcs-bridge-{}", self.config.process))
-                .spawn(move || export_loop(exports, &stop, &counters, poll, resend))
+                .spawn(move || export_loop(exports, &stop, &signal, &counters, pacing))
                 .map_err(|e| BridgeError::Zenoh(format!("bridge thread: {e}")))?
         };
         Ok(Bridge {
             config: self.config,
-            session,
+            session: Some(session),
             subscribers,
             stop,
+            signal,
             exporter: Some(exporter),
             shared,
         })
@@ -258,9 +273,11 @@ impl<'a> BridgeBuilder<'a> {
 /// the export thread. Dropping it stops the thread and closes the session.
 pub struct Bridge {
     config: BridgeConfig,
-    session: Session,
+    /// `None` once closed.
+    session: Option<Session>,
     subscribers: Vec<Subscriber<()>>,
     stop: Arc<AtomicBool>,
+    signal: CycleSignal,
     exporter: Option<JoinHandle<()>>,
     shared: Shared,
 }
@@ -326,7 +343,42 @@ impl Bridge {
 
     /// How many peer processes this bridge's session is connected to now.
     pub fn peers(&self) -> usize {
-        self.session.info().peers_zid().wait().count()
+        self.session
+            .as_ref()
+            .map_or(0, |s| s.info().peers_zid().wait().count())
+    }
+
+    /// The signal that wakes the export thread: raise it after writing
+    /// exported buffers and they are published at once, instead of at the
+    /// next fallback poll ([`BridgeConfig::poll_period`]). Give a clone to
+    /// each executive ([`Executive::set_cycle_signal`](crate::Executive::set_cycle_signal),
+    /// as the generated `System::process` does) and to any loop that writes
+    /// exported buffers outside an executive. Raising is lock- and
+    /// allocation-free.
+    pub fn signal(&self) -> CycleSignal {
+        self.signal.clone()
+    }
+
+    /// Stop the export thread, undeclare the subscribers, close the session
+    /// and return the final counters (every publish the thread made is
+    /// counted by then). Dropping the bridge does the same.
+    pub fn close(mut self) -> BridgeStats {
+        self.shut_down();
+        self.stats()
+    }
+
+    fn shut_down(&mut self) {
+        self.stop.store(true, Ordering::Release);
+        self.signal.raise();
+        if let Some(t) = self.exporter.take() {
+            let _ = t.join();
+        }
+        for s in self.subscribers.drain(..) {
+            let _ = s.undeclare().wait();
+        }
+        if let Some(session) = self.session.take() {
+            let _ = session.close().wait();
+        }
     }
 
     /// The name of the export thread, `rcs-bridge-<process>` (what
@@ -338,14 +390,7 @@ impl Bridge {
 
 impl Drop for Bridge {
     fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(t) = self.exporter.take() {
-            let _ = t.join();
-        }
-        for s in self.subscribers.drain(..) {
-            let _ = s.undeclare().wait();
-        }
-        let _ = self.session.close().wait();
+        self.shut_down();
     }
 }
 

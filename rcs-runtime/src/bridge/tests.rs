@@ -12,10 +12,10 @@ use crate::SetupError;
 use zenoh::Wait as _;
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-struct Ship {
-    speed: f64,
-    ahead: bool,
-    count: u64,
+pub(super) struct Ship {
+    pub(super) speed: f64,
+    pub(super) ahead: bool,
+    pub(super) count: u64,
 }
 
 impl Schema for Ship {
@@ -153,13 +153,14 @@ fn a_burst_keeps_only_the_newest_in_order() {
     let mut w = gm_a.writer::<Ship>("ship").unwrap();
     let mut ba = Bridge::builder(ca, &gm_a);
     ba.export::<Ship>("ship").unwrap();
-    let _ba = ba.start().unwrap();
+    let ba = ba.start().unwrap();
     let mut bb = Bridge::builder(cb, &gm_b);
     bb.import::<Ship>("ship", "a").unwrap();
     let bb = bb.start().unwrap();
     let r = gm_b.reader::<Ship>("ship").unwrap();
     // Wait until the link carries values, then write far faster than the
-    // bridge polls (1 ms) and watch B: counts only grow, and each value
+    // bridge publishes (no signal here: its fallback poll, 10 ms, and a
+    // raise every 100 writes) and watch B: counts only grow, and each value
     // arrives with the stamps of the write that made it.
     w.write(Ship::default(), 0);
     within("the link", || (r.generation() > 0).then_some(()));
@@ -190,6 +191,9 @@ fn a_burst_keeps_only_the_newest_in_order() {
             count: i,
         };
         w.write(v, i);
+        if i % 100 == 0 {
+            ba.signal().raise();
+        }
     }
     let (last, seen) = watcher.join().expect("watcher");
     assert_eq!(last, N, "the last value written arrived");

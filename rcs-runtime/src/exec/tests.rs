@@ -202,3 +202,22 @@ fn on_the_heartbeat_a_panic_lives_on_in_the_statistics() -> Result<(), SetupErro
     assert_eq!(e.step(), Ok(()));
     Ok(())
 }
+
+#[test]
+fn every_cycle_raises_the_attached_signal() -> Result<(), Box<dyn std::error::Error>> {
+    let mut exec = Executive::new(ExecutiveConfig::new("x", Duration::from_millis(1)))?;
+    exec.add(Box::new(Counter(0)))?;
+    let signal = CycleSignal::new();
+    exec.step()?;
+    assert!(!signal.take(), "not attached yet");
+    exec.set_cycle_signal(signal.clone());
+    exec.step()?;
+    assert!(signal.take());
+    assert!(!signal.take());
+    exec.run_cycles(3)?;
+    assert!(signal.take());
+    assert!(exec.take_cycle_signal().is_some());
+    exec.step()?;
+    assert!(!signal.take(), "detached");
+    Ok(())
+}

@@ -260,5 +260,3 @@ fn status_ranges() {
     // The zeroed buffer of a controller that has no verbs yet.
     assert_eq!(StatusBuffer::default().check_range(0, 0, 0, 0), Ok(()));
 }
-
-

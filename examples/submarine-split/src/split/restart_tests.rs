@@ -41,7 +41,7 @@ fn a_restarted_helm_is_not_answered_by_the_engines_old_done() {
         .expect("a free port")
         .port();
     let ep = format!("tcp/127.0.0.1:{port}");
-    let config = |role: &str| BridgeConfig::new("submarine_split", role);
+    let config = |role: &str| BridgeConfig::new("submarine_split", role).insecure();
     let (mut engine, _engine_bridge) = Sub::process(
         "engine",
         config("engine").listen(&ep),

@@ -24,13 +24,17 @@ fn a_buffer_a_command_and_status_fields_of_long_arrays_cross() {
     let ep = format!("tcp/127.0.0.1:{port}");
     let (mut planner_side, planner_bridge) = System::process(
         "planner",
-        BridgeConfig::new("long_arrays", "planner").listen(&ep).insecure(),
+        BridgeConfig::new("long_arrays", "planner")
+            .listen(&ep)
+            .insecure(),
         Hooks {},
     )
     .expect("the planner process");
     let (mut sensor_side, sensor_bridge) = System::process(
         "sensor",
-        BridgeConfig::new("long_arrays", "sensor").connect(&ep).insecure(),
+        BridgeConfig::new("long_arrays", "sensor")
+            .connect(&ep)
+            .insecure(),
         Hooks {},
     )
     .expect("the sensor process");

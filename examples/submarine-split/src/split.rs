@@ -391,7 +391,7 @@ fn helm(opts: &Options) -> Result<bool, String> {
             println!("cycle {cycle} {now} tb_stale={stale}");
             last = now;
         }
-        if opts.report_every.is_some_and(|n| cycle % n == 0) {
+        if opts.report_every.is_some_and(|n| cycle.is_multiple_of(n)) {
             let ship = system.pr().map_or(0.0, |c| c.data().reads.ship.speed);
             let stats = bridge.stats();
             println!(
@@ -471,7 +471,7 @@ fn engine(opts: &Options) -> Result<bool, String> {
             println!("cycle {cycle} {now}");
             last = now;
         }
-        if opts.report_every.is_some_and(|n| cycle % n == 0) {
+        if opts.report_every.is_some_and(|n| cycle.is_multiple_of(n)) {
             let drive = system.outputs.drive.read().value;
             println!(
                 "report cycle={cycle} rpm_setpoint={:.1} refused={}",

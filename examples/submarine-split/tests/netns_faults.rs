@@ -1,6 +1,6 @@
 //! The split submarine across network namespaces, with real faults between
 //! helm and engine (issue 24): a 3 s partition (`ip link … down`), a thin
-//! link (`tbf`, 64 kbit), and, through the test suite's own relay
+//! link (`tbf`, 128 kbit), and, through the test suite's own relay
 //! (`fault-relay`, since the test kernel has no `netem`), a 20 ± 5 ms delay
 //! per chunk, a stall, reset and refused connections, and connection
 //! attempts that reach the helm late and out of order.
@@ -200,7 +200,7 @@ fn print_figures(test: &str, figures: &[String]) {
 
 /// Helm and engine in two namespaces joined by one veth pair: the engine's
 /// link goes down for 3 s (E2 fires during the partition, the next order
-/// reaches the goal after it), then the link gets thin (tbf 64 kbit): an
+/// reaches the goal after it), then the link gets thin (tbf 128 kbit): an
 /// order still reaches the goal, and so does the next order after a 3 s
 /// partition of the thin link (whose backlog drains through it). Where the
 /// kernel has `netem`, both ends also get 20 ± 5 ms of delay until the
@@ -250,14 +250,15 @@ fn netns_partition_link_down_fires_the_watchdog_then_heals_and_a_thin_link_conve
     figures.push(r.figure("partition (link down 3 s)"));
     engine.assert_running();
 
-    // A thin link: 64 kbit each way; an order still reaches the goal.
-    thin_link(&ns, "64kbit");
+    // A thin link: 128 kbit each way (under TLS the bridge sends about
+    // 6 kB/s engine → helm); an order still reaches the goal.
+    thin_link(&ns, "128kbit");
     let ordered = Instant::now();
     helm.say("transit 10");
     helm.wait_for("the order", |l| l.starts_with("order "));
     helm.wait_for("goal line on the thin link", |l| l.starts_with("goal "));
     figures.push(format!(
-        "thin link (tbf 64 kbit): `transit 10` at the goal after {:.2} s",
+        "thin link (tbf 128 kbit): `transit 10` at the goal after {:.2} s",
         ordered.elapsed().as_secs_f64()
     ));
     // The watchdog on the thin link: how stale TB.status got at worst.

@@ -41,22 +41,8 @@ pub const OPERATOR: &str = "operator";
 /// JSON object with the keys `access_control` and `low_pass_filter`.
 pub fn policy(ir: &Ir, placement: &Placement, process: usize) -> Value {
     let key = |b: &str| format!("rcs/{}/{}", ir.system, b);
-    let mut rules: Vec<Value> = Vec::new();
-    let mut policies: Vec<Value> = Vec::new();
+    let mut acl = Acl::default();
     let mut filters: Vec<Value> = Vec::new();
-    let mut rule = |id: String, flow: &str, message: &str, keys: Vec<String>| -> Option<String> {
-        if keys.is_empty() {
-            return None;
-        }
-        rules.push(json!({
-            "id": id,
-            "flows": [flow],
-            "messages": [message],
-            "permission": "allow",
-            "key_exprs": keys,
-        }));
-        Some(id)
-    };
     // Peer processes.
     for (q, peer) in placement.processes.iter().enumerate() {
         if q == process {
@@ -75,20 +61,20 @@ pub fn policy(ir: &Ir, placement: &Placement, process: usize) -> Value {
             .map(|x| key(&buffer_name(ir, &x.kind)))
             .collect();
         let ids: Vec<String> = [
-            rule(
+            acl.allow(
                 format!("{peer}_may_subscribe"),
                 "ingress",
                 "declare_subscriber",
                 to_peer.clone(),
             ),
-            rule(format!("put_to_{peer}"), "egress", "put", to_peer),
-            rule(
+            acl.allow(format!("put_to_{peer}"), "egress", "put", to_peer),
+            acl.allow(
                 format!("{peer}_may_put"),
                 "ingress",
                 "put",
                 from_peer.clone(),
             ),
-            rule(
+            acl.allow(
                 format!("subscribe_at_{peer}"),
                 "egress",
                 "declare_subscriber",
@@ -98,9 +84,7 @@ pub fn policy(ir: &Ir, placement: &Placement, process: usize) -> Value {
         .into_iter()
         .flatten()
         .collect();
-        if !ids.is_empty() {
-            policies.push(json!({ "subjects": [peer], "rules": ids }));
-        }
+        acl.grant(peer, ids);
     }
     // The operator: root commands in, statuses out.
     let here: Vec<usize> = (0..ir.controllers.len())
@@ -116,32 +100,30 @@ pub fn policy(ir: &Ir, placement: &Placement, process: usize) -> Value {
         .map(|&c| key(&format!("{}.status", ir.controllers[c].name)))
         .collect();
     let ids: Vec<String> = [
-        rule(
+        acl.allow(
             format!("commands_from_{OPERATOR}"),
             "egress",
             "declare_subscriber",
             root_commands.clone(),
         ),
-        rule(
+        acl.allow(
             format!("{OPERATOR}_may_command"),
             "ingress",
             "put",
             root_commands,
         ),
-        rule(
+        acl.allow(
             format!("{OPERATOR}_may_subscribe"),
             "ingress",
             "declare_subscriber",
             statuses.clone(),
         ),
-        rule(format!("statuses_to_{OPERATOR}"), "egress", "put", statuses),
+        acl.allow(format!("statuses_to_{OPERATOR}"), "egress", "put", statuses),
     ]
     .into_iter()
     .flatten()
     .collect();
-    if !ids.is_empty() {
-        policies.push(json!({ "subjects": [OPERATOR], "rules": ids }));
-    }
+    acl.grant(OPERATOR, ids);
     // Size limits on what may arrive.
     for x in placement
         .crossings
@@ -165,13 +147,7 @@ pub fn policy(ir: &Ir, placement: &Placement, process: usize) -> Value {
         .collect();
     subjects.push(json!({ "id": OPERATOR, "cert_common_names": [OPERATOR] }));
     json!({
-        "access_control": {
-            "enabled": true,
-            "default_permission": "deny",
-            "rules": rules,
-            "subjects": subjects,
-            "policies": policies,
-        },
+        "access_control": acl.into_json(subjects),
         "low_pass_filter": filters,
     })
 }
@@ -182,8 +158,7 @@ pub fn policy(ir: &Ir, placement: &Placement, process: usize) -> Value {
 /// of that process's controllers, and nothing else.
 pub fn operator_policy(ir: &Ir, placement: &Placement) -> Value {
     let key = |b: String| format!("rcs/{}/{}", ir.system, b);
-    let mut rules: Vec<Value> = Vec::new();
-    let mut policies: Vec<Value> = Vec::new();
+    let mut acl = Acl::default();
     for (p, process) in placement.processes.iter().enumerate() {
         let here = (0..ir.controllers.len()).filter(|&c| placement.ctrl_process[c] == p);
         let commands: Vec<String> = here
@@ -216,36 +191,66 @@ pub fn operator_policy(ir: &Ir, placement: &Placement) -> Value {
                 &statuses,
             ),
         ] {
-            if keys.is_empty() {
-                continue;
-            }
-            rules.push(json!({
-                "id": id,
-                "flows": [flow],
-                "messages": [message],
-                "permission": "allow",
-                "key_exprs": keys,
-            }));
-            ids.push(id);
+            ids.extend(acl.allow(id, flow, message, keys.clone()));
         }
-        if !ids.is_empty() {
-            policies.push(json!({ "subjects": [process], "rules": ids }));
-        }
+        acl.grant(process, ids);
     }
     let subjects: Vec<Value> = placement
         .processes
         .iter()
         .map(|p| json!({ "id": p, "cert_common_names": [p] }))
         .collect();
-    json!({
-        "access_control": {
+    json!({ "access_control": acl.into_json(subjects) })
+}
+
+/// Zenoh's `access_control` as it is built: allow rules, and which subject
+/// holds which (everything else denied).
+#[derive(Default)]
+struct Acl {
+    rules: Vec<Value>,
+    policies: Vec<Value>,
+}
+
+impl Acl {
+    /// An allow rule `id` for `message` on `flow` over `keys`; `None` (no
+    /// rule) when there are no keys.
+    fn allow(
+        &mut self,
+        id: String,
+        flow: &str,
+        message: &str,
+        keys: Vec<String>,
+    ) -> Option<String> {
+        if keys.is_empty() {
+            return None;
+        }
+        self.rules.push(json!({
+            "id": id,
+            "flows": [flow],
+            "messages": [message],
+            "permission": "allow",
+            "key_exprs": keys,
+        }));
+        Some(id)
+    }
+
+    /// Give `subject` the rules `ids` (nothing when there are none).
+    fn grant(&mut self, subject: &str, ids: Vec<String>) {
+        if !ids.is_empty() {
+            self.policies
+                .push(json!({ "subjects": [subject], "rules": ids }));
+        }
+    }
+
+    fn into_json(self, subjects: Vec<Value>) -> Value {
+        json!({
             "enabled": true,
             "default_permission": "deny",
-            "rules": rules,
+            "rules": self.rules,
             "subjects": subjects,
-            "policies": policies,
-        },
-    })
+            "policies": self.policies,
+        })
+    }
 }
 
 /// A whole Zenoh configuration of process `process` (JSON5 with a header

@@ -34,6 +34,35 @@ pub enum Item {
     Controller(ControllerDef),
     /// `const NAME: TYPE = EXPR` at file level.
     Const(ConstDef),
+    /// `controller type T(c: TYPE, …) { … }` (LANGUAGE.md §8).
+    ControllerType(ControllerTypeDef),
+    /// `controller NAME = T(c: value, …) { local: global, … }`.
+    Instance(InstanceDef),
+}
+
+/// A controller written once: its body is a controller's, its parameters
+/// constants whose values each instance gives. `expand` turns every
+/// instance into a plain [`ControllerDef`]; nothing after it sees a type.
+#[derive(Clone, Debug)]
+pub struct ControllerTypeDef {
+    /// The body, with the type's name as its name.
+    pub def: ControllerDef,
+    pub params: Vec<Param>,
+}
+
+/// `controller NAME = T(c: value, …) { local: global, … }`.
+#[derive(Clone, Debug)]
+pub struct InstanceDef {
+    pub outer: Outer,
+    pub name: Name,
+    /// The type's name.
+    pub ty: Name,
+    pub args: Vec<(Name, Expr)>,
+    pub title: Option<String>,
+    /// `local: global`: a `reads`/`writes` buffer or a subordinate of the
+    /// type, and what it is in this instance.
+    pub bindings: Vec<(Name, Name)>,
+    pub span: Span,
 }
 
 /// `const NAME: TYPE = EXPR`, at file or controller level.
@@ -137,6 +166,25 @@ pub enum EntryKind {
     },
     /// `pre { jobs }` or `post { jobs }`: jobs run every cycle.
     EveryCycle(EveryCycleDef),
+    /// `rows NAME { row… }`: rows that plans `use` (removed by `expand`).
+    Rows(RowsDef),
+    /// `jobs NAME(p: T, …) { job… }`: a job list (removed by `expand`).
+    Jobs(JobsDef),
+}
+
+/// `rows NAME { row… }`.
+#[derive(Clone, Debug)]
+pub struct RowsDef {
+    pub name: Name,
+    pub rows: Vec<Row>,
+}
+
+/// `jobs NAME(p: T, …) { job… }`.
+#[derive(Clone, Debug)]
+pub struct JobsDef {
+    pub name: Name,
+    pub params: Vec<Param>,
+    pub jobs: Vec<Job>,
 }
 
 /// Which every-cycle block: before the rows (`pre`) or after them (`post`).
@@ -182,6 +230,17 @@ pub struct PlanDef {
     pub rows: Vec<Row>,
     /// The verbs after the first in `plan A | B | C` (empty for one verb).
     pub more_verbs: Vec<Name>,
+    /// `use NAME` lines: each goes before `rows[at]` (`expand` splices
+    /// the block's rows there and empties this list).
+    pub uses: Vec<Use>,
+}
+
+/// `use NAME` in a plan.
+#[derive(Clone, Debug)]
+pub struct Use {
+    pub at: usize,
+    pub name: Name,
+    pub span: Span,
 }
 
 #[derive(Clone, Debug)]
@@ -197,6 +256,16 @@ pub struct Row {
     pub target: Target,
     pub jobs: Vec<Job>,
     pub span: Span,
+    /// Set by `expand` on a row placed by `use NAME`: the block's name and
+    /// the `use` line.
+    pub shared: Option<Box<SharedOrigin>>,
+}
+
+/// Where a row placed by `use` came from.
+#[derive(Clone, Debug)]
+pub struct SharedOrigin {
+    pub block: Name,
+    pub use_span: Span,
 }
 
 #[derive(Clone, Debug)]
@@ -204,6 +273,11 @@ pub enum From {
     /// `*` or `*N`.
     DontCare(Option<u64>, Span),
     State(Name),
+    /// `A | B | C` (two or more states); the span covers the list.
+    States(Vec<Name>, Span),
+    /// `*N except A | B`: the `*N` as for `DontCare`, the states left out,
+    /// and the span of the whole pattern.
+    Except(Option<u64>, Vec<Name>, Span),
     /// An `otherwise` row written without `*`.
     Implicit,
 }

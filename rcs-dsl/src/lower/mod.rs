@@ -283,6 +283,8 @@ fn collect_items<'a>(files: &'a [ast::File], diags: &mut Diagnostics) -> Globals
                 &c.name,
                 ItemRef::Controller(CtrlId(g.controllers.len() as u32)),
             ),
+            // `expand` replaced types and instances with controllers.
+            ast::Item::ControllerType(_) | ast::Item::Instance(_) => continue,
         };
         if PRIMITIVES.contains(&name.text.as_str()) && !matches!(r, ItemRef::Controller(_)) {
             diags.push(
@@ -305,7 +307,7 @@ fn collect_items<'a>(files: &'a [ast::File], diags: &mut Diagnostics) -> Globals
             ast::Item::Enum(e) => g.enums.push(e),
             ast::Item::Buffer(b) => g.buffers.push(b),
             ast::Item::Controller(c) => g.controllers.push(c),
-            ast::Item::Const(_) => {}
+            ast::Item::Const(_) | ast::Item::ControllerType(_) | ast::Item::Instance(_) => {}
         }
     }
     // Constants and items share no names (a controller's name is a value
@@ -325,5 +327,7 @@ fn item_name(item: &ast::Item) -> Option<&ast::Name> {
         ast::Item::Buffer(b) => &b.name,
         ast::Item::Controller(c) => &c.name,
         ast::Item::Const(c) => &c.name,
+        ast::Item::ControllerType(t) => &t.def.name,
+        ast::Item::Instance(i) => &i.name,
     })
 }

@@ -89,6 +89,16 @@ impl Cx<'_, '_> {
                 (From::DontCare(None), n.span)
             }
             ast::From::State(n) => (From::State(intern(states, n)), n.span),
+            // Lowered by the state-set change (LANGUAGE.md §8); until then refused.
+            ast::From::States(_, s) | ast::From::Except(_, _, s) => {
+                self.diags.push(Diagnostic::error(
+                    Code::Syntax,
+                    "state sets are not lowered yet",
+                    *s,
+                    "here",
+                ));
+                (From::DontCare(None), *s)
+            }
         };
         let (cond, is_entry) = match &r.cond {
             None => (Condition::Otherwise, false),

@@ -122,7 +122,7 @@ fn one_of(words: &[String]) -> String {
 fn rule_words(rule: Rule) -> Option<&'static str> {
     Some(match rule {
         Rule::EOI => "end of file",
-        Rule::item => "an item (`enum`, `buffer` or `controller`)",
+        Rule::item => "an item (`enum`, `buffer`, `const` or `controller`)",
         Rule::doc_comment => return None,
         Rule::attribute => "an attribute `#[…]`",
         Rule::ident => "a name",
@@ -156,6 +156,10 @@ fn rule_words(rule: Rule) -> Option<&'static str> {
         Rule::kw_as => "`as`",
         Rule::kw_same => "`same`",
         Rule::kw_report => "`report`",
+        Rule::kw_except => "`except`",
+        Rule::use_rows => "`use NAME`",
+        Rule::binding => "a binding `local: global`",
+        Rule::except_states => "`except`",
         _ => return None,
     })
 }

@@ -57,10 +57,7 @@ impl Builder {
                 let mut entries = Vec::with_capacity(inner.len());
                 for c in inner {
                     match c.as_rule() {
-                        Rule::string_lit => {
-                            let s = c.as_str();
-                            title = Some(unescape(&s[1..s.len() - 1]));
-                        }
+                        Rule::string_lit => title = Some(Self::title(&c)),
                         Rule::entry => {
                             if let Some(e) = self.entry(c) {
                                 entries.push(e);
@@ -78,8 +75,75 @@ impl Builder {
                 })
             }
             Rule::const_def => Item::Const(self.const_def(def)?),
+            Rule::controller_type_def => {
+                inner.next(); // controller
+                inner.next(); // type
+                let name = self.name(inner.next()?);
+                let mut title = None;
+                let mut params = Vec::new();
+                let mut entries = Vec::with_capacity(inner.len());
+                for c in inner {
+                    match c.as_rule() {
+                        Rule::string_lit => title = Some(Self::title(&c)),
+                        Rule::param => params.extend(self.params(std::iter::once(c))),
+                        Rule::entry => entries.extend(self.entry(c)),
+                        _ => {}
+                    }
+                }
+                Item::ControllerType(ControllerTypeDef {
+                    def: ControllerDef {
+                        outer,
+                        name,
+                        title,
+                        entries,
+                        span,
+                    },
+                    params,
+                })
+            }
+            Rule::instance_def => {
+                inner.next(); // controller
+                let name = self.name(inner.next()?);
+                let ty = self.name(inner.next()?);
+                let mut title = None;
+                let mut args = Vec::new();
+                let mut bindings = Vec::new();
+                for c in inner {
+                    match c.as_rule() {
+                        Rule::string_lit => title = Some(Self::title(&c)),
+                        Rule::named_arg => {
+                            let mut ai = c.into_inner();
+                            let n = self.name(ai.next()?);
+                            let e = self.expr(ai.next()?);
+                            args.push((n, e));
+                        }
+                        Rule::binding => {
+                            let mut bi = c.into_inner();
+                            let local = self.name(bi.next()?);
+                            let global = self.name(bi.next()?);
+                            bindings.push((local, global));
+                        }
+                        _ => {}
+                    }
+                }
+                Item::Instance(InstanceDef {
+                    outer,
+                    name,
+                    ty,
+                    args,
+                    title,
+                    bindings,
+                    span,
+                })
+            }
             _ => return None,
         })
+    }
+
+    /// A title string's text.
+    fn title(p: &Pair<Rule>) -> String {
+        let s = p.as_str();
+        unescape(&s[1..s.len() - 1])
     }
 
     /// `const NAME: TYPE = EXPR` (constants).
@@ -240,12 +304,23 @@ impl Builder {
                 // Sized once (the rows are most of the AST, and growing by
                 // doubling left a quarter of it unused).
                 let mut rows = Vec::with_capacity(inner.len());
+                let mut uses = Vec::new();
                 for c in inner {
-                    if c.as_rule() == Rule::ident {
-                        header = header.to(self.span(&c));
-                        more_verbs.push(self.name(c));
-                    } else {
-                        rows.push(self.row(c));
+                    match c.as_rule() {
+                        Rule::ident => {
+                            header = header.to(self.span(&c));
+                            more_verbs.push(self.name(c));
+                        }
+                        Rule::use_rows => {
+                            let span = self.span(&c);
+                            let name = self.name(c.into_inner().nth(1)?);
+                            uses.push(Use {
+                                at: rows.len(),
+                                name,
+                                span,
+                            });
+                        }
+                        _ => rows.push(self.row(c)),
                     }
                 }
                 EntryKind::Plan(PlanDef {
@@ -253,9 +328,28 @@ impl Builder {
                     header,
                     rows,
                     more_verbs,
+                    uses,
                 })
             }
             Rule::const_def => EntryKind::Const(self.const_def(decl)?),
+            Rule::rows_def => {
+                let name = self.name(inner.next()?);
+                let rows = inner.map(|r| self.row(r)).collect();
+                EntryKind::Rows(RowsDef { name, rows })
+            }
+            Rule::jobs_def => {
+                let name = self.name(inner.next()?);
+                let mut params = Vec::new();
+                let mut jobs = Vec::new();
+                for c in inner {
+                    match c.as_rule() {
+                        Rule::param => params.extend(self.params(std::iter::once(c))),
+                        Rule::jobs => jobs = c.into_inner().map(|j| self.job(j)).collect(),
+                        _ => {}
+                    }
+                }
+                EntryKind::Jobs(JobsDef { name, params, jobs })
+            }
             _ => return None,
         };
         Some(Entry { outer, kind, span })

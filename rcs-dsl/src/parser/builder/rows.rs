@@ -23,13 +23,7 @@ impl Builder {
                     let n = c.as_str()[1..].parse::<u64>().unwrap_or(u64::MAX);
                     label = Some((n, s));
                 }
-                Rule::from_state => {
-                    let c = c.into_inner().next().expect("from has one child");
-                    from = Some(match c.as_rule() {
-                        Rule::dont_care => self.dont_care(c),
-                        _ => From::State(self.name(c)),
-                    });
-                }
+                Rule::from_state => from = Some(self.from_state(c)),
                 Rule::kw_otherwise => {
                     cond_span = self.span(&c);
                     otherwise = Some(cond_span);
@@ -51,10 +45,16 @@ impl Builder {
             }
         }
         let from = match (from, otherwise) {
-            (Some(From::State(n)), Some(_)) => {
+            (Some(f @ (From::State(_) | From::States(..) | From::Except(..))), Some(_)) => {
+                let (span, what) = match &f {
+                    From::State(n) => (n.span, format!("in state `{}`", n.text)),
+                    From::States(_, s) => (*s, "in a set of states".to_string()),
+                    From::Except(_, _, s) => (*s, "with `except`".to_string()),
+                    _ => unreachable!("matched above"),
+                };
                 self.error(
-                    n.span,
-                    format!("an `otherwise` row cannot start in state `{}`", n.text),
+                    span,
+                    format!("an `otherwise` row cannot start {what}"),
                     "`otherwise` applies in every state",
                 );
                 self.diags.last_mut().expect("just pushed").help =
@@ -84,6 +84,37 @@ impl Builder {
             target: target.expect("row has a target"),
             jobs,
             span,
+            shared: None,
+        }
+    }
+
+    /// `*N`, `*N except A | B`, `A`, or `A | B | C`.
+    fn from_state(&mut self, p: Pair<Rule>) -> From {
+        let whole = self.span(&p);
+        let mut inner = p.into_inner();
+        let first = inner.next().expect("from has a first part");
+        if first.as_rule() == Rule::dont_care {
+            let From::DontCare(n, span) = self.dont_care(first) else {
+                unreachable!("dont_care builds a DontCare")
+            };
+            return match inner.next() {
+                Some(except) => {
+                    let names = except
+                        .into_inner()
+                        .filter(|c| c.as_rule() == Rule::ident)
+                        .map(|c| self.name(c))
+                        .collect();
+                    From::Except(n, names, whole)
+                }
+                None => From::DontCare(n, span),
+            };
+        }
+        let mut names = vec![self.name(first)];
+        names.extend(inner.map(|c| self.name(c)));
+        if names.len() == 1 {
+            From::State(names.pop().expect("one name"))
+        } else {
+            From::States(names, whole)
         }
     }
 

@@ -125,6 +125,23 @@ pub struct ControllerDef {
     pub title: Option<String>,
     pub entries: Vec<Entry>,
     pub span: Span,
+    /// Set by `expand` on a controller made from an instance of a type.
+    pub instance: Option<Box<InstanceOf>>,
+}
+
+/// What an instance was made from (kept in the IR for the code generator
+/// and the docs).
+#[derive(Clone, Debug)]
+pub struct InstanceOf {
+    /// The type's name and where it is defined.
+    pub ty: Name,
+    pub type_span: Span,
+    /// The instance declaration.
+    pub span: Span,
+    /// Each const parameter and its argument, in parameter order.
+    pub args: Vec<(Name, Expr)>,
+    /// `local: global` as written in the instance.
+    pub bindings: Vec<(Name, Name)>,
 }
 
 /// One entry of a controller body, with its docs.
@@ -177,6 +194,8 @@ pub enum EntryKind {
 pub struct RowsDef {
     pub name: Name,
     pub rows: Vec<Row>,
+    /// `use` lines inside the block (always an error: blocks do not nest).
+    pub uses: Vec<Use>,
 }
 
 /// `jobs NAME(p: T, …) { job… }`.
@@ -420,6 +439,47 @@ pub enum ExprKind {
     Binary(BinOp, Box<[Expr; 2]>),
     Cast(Box<Expr>, Name),
     Paren(Box<Expr>),
+}
+
+impl Expr {
+    /// Call `f` on this expression and, where `f` returns true, on its
+    /// sub-expressions (parents first). `expand` rewrites names with it.
+    pub fn walk_mut(&mut self, f: &mut dyn FnMut(&mut Expr) -> bool) {
+        if !f(self) {
+            return;
+        }
+        match &mut self.kind {
+            ExprKind::Call(_, args) => args.iter_mut().for_each(|a| a.walk_mut(f)),
+            ExprKind::Field(b, _)
+            | ExprKind::Unary(_, b)
+            | ExprKind::Cast(b, _)
+            | ExprKind::Paren(b) => b.walk_mut(f),
+            ExprKind::Index(a, b) => {
+                a.walk_mut(f);
+                b.walk_mut(f);
+            }
+            ExprKind::Binary(_, ops) => ops.iter_mut().for_each(|o| o.walk_mut(f)),
+            _ => {}
+        }
+    }
+
+    /// Call `f` on this expression and every sub-expression, parents first.
+    pub fn walk<'a>(&'a self, f: &mut dyn FnMut(&'a Expr)) {
+        f(self);
+        match &self.kind {
+            ExprKind::Call(_, args) => args.iter().for_each(|a| a.walk(f)),
+            ExprKind::Field(b, _)
+            | ExprKind::Unary(_, b)
+            | ExprKind::Cast(b, _)
+            | ExprKind::Paren(b) => b.walk(f),
+            ExprKind::Index(a, b) => {
+                a.walk(f);
+                b.walk(f);
+            }
+            ExprKind::Binary(_, ops) => ops.iter().for_each(|o| o.walk(f)),
+            _ => {}
+        }
+    }
 }
 
 #[cfg(test)]

@@ -62,11 +62,14 @@ pub enum Code {
     EveryCycleDecision,
     EveryCycleTwice,
     Placement,
+    SharedRows,
+    JobList,
+    Instance,
 }
 
 impl Code {
     /// Every hard-error code, in catalogue order (lints follow in [`Lint::ALL`]).
-    pub const ERRORS: [Code; 31] = [
+    pub const ERRORS: [Code; 34] = [
         Code::Syntax,
         Code::DuplicateDefinition,
         Code::UnknownName,
@@ -98,6 +101,9 @@ impl Code {
         Code::EveryCycleDecision,
         Code::EveryCycleTwice,
         Code::Placement,
+        Code::SharedRows,
+        Code::JobList,
+        Code::Instance,
     ];
 
     pub fn name(self) -> &'static str {
@@ -134,6 +140,9 @@ impl Code {
             Code::EveryCycleDecision => "every_cycle_decision",
             Code::EveryCycleTwice => "every_cycle_twice",
             Code::Placement => "placement",
+            Code::SharedRows => "shared_rows",
+            Code::JobList => "job_list",
+            Code::Instance => "instance",
         }
     }
 
@@ -203,6 +212,15 @@ impl Code {
             Code::EveryCycleTwice => "a controller has two `pre` or two `post` blocks",
             Code::Placement => {
                 "a CPU's `process:` or `inputs:` in `rcs.yaml` does not place it"
+            }
+            Code::SharedRows => {
+                "a `rows` block or a `use` is written wrongly: a label or `use` inside a block, an unknown block"
+            }
+            Code::JobList => {
+                "a job list is called where it cannot be, calls itself, or is given an argument it would change"
+            }
+            Code::Instance => {
+                "an instance names no controller type, or binds its buffers and subordinates wrongly"
             }
         }
     }

@@ -266,6 +266,28 @@ pub struct Controller {
     /// `post { … }`: jobs run every cycle after the row, or none (step 4b).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub post: Option<EveryCycle>,
+    /// The controller type this controller is an instance of (LANGUAGE.md
+    /// §8); `None` for a controller written out.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub instance_of: Option<InstanceOf>,
+}
+
+/// What an instance was made from: its type, and its arguments and
+/// bindings as written.
+#[derive(Clone, Debug, Serialize)]
+pub struct InstanceOf {
+    /// The type's name.
+    #[serde(rename = "type")]
+    pub ty: String,
+    /// The whole `controller type … { … }`.
+    pub type_span: Span,
+    /// The instance declaration.
+    pub span: Span,
+    /// Each const parameter and its value as written, in parameter order.
+    pub args: Vec<(String, String)>,
+    /// `local: global`: each buffer and subordinate of the type, and what
+    /// it is in this instance.
+    pub bindings: Vec<(String, String)>,
 }
 
 /// The jobs of a `pre` or `post` block: assignments and hook calls only
@@ -411,6 +433,19 @@ pub struct Row {
     pub cond_span: Span,
     pub to_span: Span,
     pub label_span: Option<Span>,
+    /// The `rows` block this row was placed from by `use` (LANGUAGE.md
+    /// §8); its spans are the block's row.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shared: Option<SharedRow>,
+}
+
+/// Where a row placed by `use NAME` came from.
+#[derive(Clone, Debug, Serialize)]
+pub struct SharedRow {
+    /// The block's name.
+    pub block: String,
+    /// The `use NAME` line in this plan.
+    pub use_span: Span,
 }
 
 impl Row {

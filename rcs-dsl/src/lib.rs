@@ -3,9 +3,13 @@
 //! The pipeline is one way, one type per stage:
 //!
 //! ```text
-//! paths ──load──▶ PlanSet ──parse──▶ ast::File ──lower──▶ ir::Ir ──checks──▶ findings
-//!                                                               (asking analysis)
+//! paths ──load──▶ PlanSet ──parse──▶ ast::File ──expand──▶ ast::File ──lower──▶ ir::Ir ──checks──▶ findings
+//!                                                                                 (asking analysis)
 //! ```
+//!
+//! `expand` turns LANGUAGE.md §8's shared constructs (job lists, shared
+//! rows, controller types) into plain rows, jobs and controllers, so that
+//! no later stage knows them.
 //!
 //! A finding that something can happen carries a witness, and where a path
 //! to it is found a run ([`analysis::run`]): replayed on the interpreter,
@@ -27,6 +31,7 @@ pub mod builtin;
 mod checks;
 pub mod diagnostic;
 pub mod diff;
+mod expand;
 pub mod interp;
 pub mod ir;
 pub mod lint;
@@ -74,11 +79,15 @@ impl Checked {
 /// Check a loaded plan set: parse, lower, validate.
 pub fn check(set: &PlanSet, options: &Options) -> Checked {
     let mut diags = Diagnostics::new();
-    let Some(parsed) = parse(set, &mut diags) else {
-        return finish(None, diags);
+    let Some(mut parsed) = parse(set, &mut diags) else {
+        return finish(None, diags, &expand::Origins::default());
     };
+    let origins = expand::expand(&mut parsed.files, &mut diags);
+    if diags.has_errors() {
+        return finish(None, diags, &origins);
+    }
     let Some(ir) = lower_files(set, parsed, &mut diags) else {
-        return finish(None, diags);
+        return finish(None, diags, &origins);
     };
     let mut levels = LintLevels::default();
     for &(lint, level) in set.manifest.lints.iter().chain(&options.lint_flags) {
@@ -86,7 +95,7 @@ pub fn check(set: &PlanSet, options: &Options) -> Checked {
     }
     checks::run(&ir, &levels, &set.sources, &mut diags);
     let ir = (!diags.has_errors()).then_some(ir);
-    finish(ir, diags)
+    finish(ir, diags, &origins)
 }
 
 /// Parse and lower a plan set without running the checks: the IR even of
@@ -99,7 +108,11 @@ pub fn lower_unchecked(set: &PlanSet) -> Option<ir::Ir> {
 
 /// Stages 0–2: the load diagnostics, parsing and lowering.
 fn front(set: &PlanSet, diags: &mut Diagnostics) -> Option<ir::Ir> {
-    let parsed = parse(set, diags)?;
+    let mut parsed = parse(set, diags)?;
+    expand::expand(&mut parsed.files, diags);
+    if diags.has_errors() {
+        return None;
+    }
     lower_files(set, parsed, diags)
 }
 
@@ -192,10 +205,10 @@ fn parse_all(set: &PlanSet, ids: &[source::FileId]) -> Vec<(ParseResult, paralle
     })
 }
 
-fn finish(ir: Option<ir::Ir>, diags: Diagnostics) -> Checked {
+fn finish(ir: Option<ir::Ir>, diags: Diagnostics, origins: &expand::Origins) -> Checked {
     Checked {
         ir,
-        diagnostics: diags.into_vec(),
+        diagnostics: expand::attribute(diags.into_vec(), origins),
     }
 }
 

@@ -45,6 +45,24 @@ pub(super) fn lower_controller_headers<'a>(
             buffer_docs: Vec::new(),
             pre: None,
             post: None,
+            instance_of: c.instance.as_ref().map(|i| crate::ir::InstanceOf {
+                ty: i.ty.text.to_string(),
+                type_span: i.type_span,
+                span: i.span,
+                args: i
+                    .args
+                    .iter()
+                    .map(|(n, e)| {
+                        let text = &sources.get(e.span.file).text[e.span.range()];
+                        (n.text.to_string(), text.to_string())
+                    })
+                    .collect(),
+                bindings: i
+                    .bindings
+                    .iter()
+                    .map(|(l, g)| (l.text.to_string(), g.text.to_string()))
+                    .collect(),
+            }),
         });
     }
     // Where each controller was named as a subordinate, for multiple_supervisors.

@@ -134,6 +134,10 @@ impl Cx<'_, '_> {
             cond_span: r.cond_span,
             to_span: r.target.span(),
             label_span: r.label.map(|(_, s)| s),
+            shared: r.shared.as_ref().map(|o| crate::ir::SharedRow {
+                block: o.block.text.to_string(),
+                use_span: o.use_span,
+            }),
         })
     }
 

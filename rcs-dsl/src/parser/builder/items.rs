@@ -72,6 +72,7 @@ impl Builder {
                     title,
                     entries,
                     span,
+                    instance: None,
                 })
             }
             Rule::const_def => Item::Const(self.const_def(def)?),
@@ -97,6 +98,7 @@ impl Builder {
                         title,
                         entries,
                         span,
+                        instance: None,
                     },
                     params,
                 })
@@ -138,6 +140,13 @@ impl Builder {
             }
             _ => return None,
         })
+    }
+
+    /// `use NAME`, placed before row `at`.
+    fn use_line(&mut self, p: Pair<Rule>, at: usize) -> Option<Use> {
+        let span = self.span(&p);
+        let name = self.name(p.into_inner().nth(1)?);
+        Some(Use { at, name, span })
     }
 
     /// A title string's text.
@@ -311,15 +320,7 @@ impl Builder {
                             header = header.to(self.span(&c));
                             more_verbs.push(self.name(c));
                         }
-                        Rule::use_rows => {
-                            let span = self.span(&c);
-                            let name = self.name(c.into_inner().nth(1)?);
-                            uses.push(Use {
-                                at: rows.len(),
-                                name,
-                                span,
-                            });
-                        }
+                        Rule::use_rows => uses.push(self.use_line(c, rows.len())?),
                         _ => rows.push(self.row(c)),
                     }
                 }
@@ -334,8 +335,16 @@ impl Builder {
             Rule::const_def => EntryKind::Const(self.const_def(decl)?),
             Rule::rows_def => {
                 let name = self.name(inner.next()?);
-                let rows = inner.map(|r| self.row(r)).collect();
-                EntryKind::Rows(RowsDef { name, rows })
+                let mut rows = Vec::with_capacity(inner.len());
+                let mut uses = Vec::new();
+                for c in inner {
+                    if c.as_rule() == Rule::use_rows {
+                        uses.push(self.use_line(c, rows.len())?);
+                    } else {
+                        rows.push(self.row(c));
+                    }
+                }
+                EntryKind::Rows(RowsDef { name, rows, uses })
             }
             Rule::jobs_def => {
                 let name = self.name(inner.next()?);

@@ -48,6 +48,9 @@ pub fn controller_tables(ir: &Ir, ctrl: &Controller) -> String {
     if !ctrl.docs.is_empty() {
         let _ = writeln!(out, "{}\n", ctrl.docs.join("\n"));
     }
+    if let Some(inst) = &ctrl.instance_of {
+        let _ = writeln!(out, "{}\n", instance_line(inst));
+    }
     let subs: Vec<&str> = ctrl
         .subordinates
         .iter()
@@ -110,11 +113,14 @@ pub fn controller_tables(ir: &Ir, ctrl: &Controller) -> String {
                 p.from(r)
             };
             let (next, jobs) = next_and_jobs(&p, r);
-            let row = if r.is_otherwise() {
+            let mut row = if r.is_otherwise() {
                 crate::dot::otherwise_name(r)
             } else {
                 p.label(r)
             };
+            if let Some(shared) = &r.shared {
+                let _ = write!(row, " (`{}`)", shared.block);
+            }
             let mut jobs: Vec<String> = jobs.iter().map(|j| code(j)).collect();
             match r.to {
                 Target::Done => jobs.push("status DONE".to_string()),
@@ -136,9 +142,43 @@ pub fn controller_tables(ir: &Ir, ctrl: &Controller) -> String {
             }
             out.push('\n');
         }
+        let mut blocks: Vec<&str> = plan
+            .rows
+            .iter()
+            .filter_map(|r| r.shared.as_ref().map(|s| s.block.as_str()))
+            .collect();
+        blocks.dedup();
+        if !blocks.is_empty() {
+            let list: Vec<String> = blocks.iter().map(|b| format!("`rows {b}`")).collect();
+            let _ = writeln!(
+                out,
+                "\nRows marked (`NAME`) are placed by `use NAME` from {}, written once for every plan that uses it.",
+                list.join(", ")
+            );
+        }
         out.push('\n');
     }
     out
+}
+
+/// "An instance of `T`(args), with …": an instance's line under its
+/// title, for its tables and its page.
+pub fn instance_line(inst: &rcs_dsl::ir::InstanceOf) -> String {
+    let args: Vec<String> = inst.args.iter().map(|(n, v)| format!("{n}: {v}")).collect();
+    let mut line = format!("An instance of controller type `{}`", inst.ty);
+    if !args.is_empty() {
+        let _ = write!(line, " with {}", args.join(", "));
+    }
+    if !inst.bindings.is_empty() {
+        let b: Vec<String> = inst
+            .bindings
+            .iter()
+            .map(|(l, g)| format!("`{l}` is `{g}`"))
+            .collect();
+        let _ = write!(line, "; {}", b.join(", "));
+    }
+    line.push('.');
+    line
 }
 
 /// Status fields and `pre`/`post` jobs, before the tables (nothing for a

@@ -37,7 +37,24 @@ pub fn markdown(diff: &PlanSetDiff) -> String {
         for c in &s.controllers {
             let _ = writeln!(out, "### Controller `{}`{}\n", c.name, presence(c.presence));
             items(&mut out, &c.items);
-            for p in &c.plans {
+            for b in &c.blocks {
+                let _ = writeln!(
+                    out,
+                    "#### Rows `{}` (lands at {})\n",
+                    b.name,
+                    b.plans.join("; ")
+                );
+                out.push_str("| Change | Before | After |\n|---|---|---|\n");
+                for r in &b.rows {
+                    let what = match &r.change {
+                        RowChange::Changed(parts) => format!("changed ({})", parts.join(", ")),
+                        _ => row_word(r).to_string(),
+                    };
+                    let _ = writeln!(out, "| {what} | {} | {} |", content(&r.old), content(&r.new));
+                }
+                out.push('\n');
+            }
+            for p in c.plans.iter().filter(|p| p.changed_outside_blocks()) {
                 let _ = writeln!(out, "#### Plan `{}`{}\n", p.name(), presence(p.presence));
                 for st in &p.states_added {
                     let _ = writeln!(out, "- ➕ state `{st}`");
@@ -52,6 +69,7 @@ pub fn markdown(diff: &PlanSetDiff) -> String {
                     .rows
                     .iter()
                     .filter(|r| r.change != RowChange::Same || r.renumbered())
+                    .filter(|r| r.block().is_none() || !r.is_change())
                     .collect();
                 if !changed.is_empty() {
                     out.push_str("| Row | Change | Before | After |\n|---|---|---|---|\n");

@@ -58,7 +58,17 @@ pub fn text(diff: &PlanSetDiff, color: bool) -> String {
                 let (m, t) = item_line(i);
                 let _ = writeln!(out, "    {}", paint.mark(m, &t));
             }
-            for p in &c.plans {
+            for b in &c.blocks {
+                let _ = writeln!(
+                    out,
+                    "    {}",
+                    paint.bold(&format!("rows {} (lands at {})", b.name, b.plans.join("; ")))
+                );
+                for r in &b.rows {
+                    block_row(&mut out, &paint, r);
+                }
+            }
+            for p in c.plans.iter().filter(|p| p.changed_outside_blocks()) {
                 let _ = writeln!(
                     out,
                     "    {}",
@@ -70,7 +80,7 @@ pub fn text(diff: &PlanSetDiff, color: bool) -> String {
                 for st in &p.states_removed {
                     let _ = writeln!(out, "      {}", paint.mark('-', &format!("state {st}")));
                 }
-                for r in &p.rows {
+                for r in p.rows.iter().filter(|r| r.block().is_none() || !r.is_change()) {
                     row(&mut out, &paint, r);
                 }
                 for m in &p.moves {
@@ -112,6 +122,25 @@ fn row(out: &mut String, paint: &Paint, r: &RowDiff) {
         }
         (RowChange::Same, _, _) if r.renumbered() => {
             let _ = writeln!(out, "      = {}", row_name(r));
+        }
+        _ => {}
+    }
+}
+
+/// A changed row of a `rows` block: its content, without a plan's label.
+fn block_row(out: &mut String, paint: &Paint, r: &RowDiff) {
+    match (&r.change, &r.old, &r.new) {
+        (RowChange::Added, _, Some(n)) => {
+            let _ = writeln!(out, "      {}", paint.mark('+', &n.content()));
+        }
+        (RowChange::Removed, Some(o), _) => {
+            let _ = writeln!(out, "      {}", paint.mark('-', &o.content()));
+        }
+        (RowChange::Changed(_), Some(o), _) => {
+            let _ = writeln!(out, "      {}", paint.mark('~', &o.content()));
+            for (part, a, b) in changed_parts(r) {
+                let _ = writeln!(out, "          {part}: {a} → {b}");
+            }
         }
         _ => {}
     }

@@ -164,6 +164,14 @@ pub(super) fn changes_page(site: &Site, changes: &Changes, svgs: &Svgs) -> Strin
                 presence(c.presence)
             );
             items(&mut body, &c.items);
+            for b in &c.blocks {
+                let _ = writeln!(
+                    body,
+                    "<p class=\"block-change\">Rows <code>{}</code> changed, once for every plan that uses it: {}.</p>",
+                    esc(&b.name),
+                    esc(&b.plans.join("; "))
+                );
+            }
             for p in &c.plans {
                 let plan = ctrl.and_then(|k| {
                     k.plans

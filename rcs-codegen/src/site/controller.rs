@@ -28,6 +28,30 @@ pub(super) fn controller_page(site: &Site, set: &SetDoc, ci: usize, placed: &Pla
         let _ = writeln!(body, "<p class=\"title\">{}</p>", esc(t));
     }
     body.push_str(&docs(&c.docs));
+    if let Some(inst) = &c.instance_of {
+        let mut line = format!(
+            "An instance of controller type <a href=\"{}\"><code>{}</code></a>",
+            super::types::type_page_name(&inst.ty),
+            esc(&inst.ty)
+        );
+        let args: Vec<String> = inst
+            .args
+            .iter()
+            .map(|(n, v)| format!("<code>{}: {}</code>", esc(n), esc(v)))
+            .collect();
+        if !args.is_empty() {
+            let _ = write!(line, " with {}", args.join(", "));
+        }
+        let binds: Vec<String> = inst
+            .bindings
+            .iter()
+            .map(|(l, g)| format!("<code>{}</code> is <code>{}</code>", esc(l), esc(g)))
+            .collect();
+        if !binds.is_empty() {
+            let _ = write!(line, "; {}", binds.join(", "));
+        }
+        let _ = writeln!(body, "<p class=\"instance\">{line}.</p>");
+    }
     let sup = c
         .supervisor
         .map(link)

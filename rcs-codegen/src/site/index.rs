@@ -102,12 +102,22 @@ pub(super) fn controllers_table(ir: &Ir, prefix: &str, members: &[usize]) -> Str
                 )
             })
             .collect();
+        let mut title = esc(c.title.as_deref().unwrap_or(""));
+        if let Some(inst) = &c.instance_of {
+            let _ = write!(
+                title,
+                "{}<a href=\"{prefix}{}\">{}</a> instance",
+                if title.is_empty() { "" } else { " — " },
+                super::types::type_page_name(&inst.ty),
+                esc(&inst.ty)
+            );
+        }
         let _ = writeln!(
             out,
             "<tr><td><a href=\"{prefix}{}\">{}</a></td><td>{}</td><td>{}</td><td>{sup}</td><td>{}</td></tr>",
             ctrl_page(c),
             esc(&c.name),
-            esc(c.title.as_deref().unwrap_or("")),
+            title,
             esc(&cpu),
             plans.join(" ")
         );

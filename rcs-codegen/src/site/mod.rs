@@ -31,6 +31,7 @@ mod index;
 mod plan;
 pub mod runs;
 mod svg;
+mod types;
 
 pub use clusters::{CLUSTER_MAX, LARGE_SET, LIST_PAGE};
 pub use runs::RunCounts;
@@ -191,6 +192,12 @@ pub fn pages(site: &Site, svgs: &Svgs) -> Vec<OutputFile> {
         let folder = folder(site, set);
         if clusters::is_large(set.ir) {
             files.extend(clusters::pages(site, set, svgs));
+        }
+        for (ty, instances) in types::types(set.ir) {
+            files.push(OutputFile {
+                path: format!("{folder}{}", types::type_page_name(ty)),
+                contents: types::type_page(site, set, ty, &instances),
+            });
         }
         for (ci, ctrl) in set.ir.controllers.iter().enumerate() {
             files.push(OutputFile {

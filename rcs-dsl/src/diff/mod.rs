@@ -40,6 +40,7 @@ pub use findings::Finding;
 pub use precedence::{Effect, Move};
 pub use rows::{RowChange, RowDiff, RowView};
 
+
 /// One side of a diff: a checked plan set.
 pub struct Side<'a> {
     pub ir: &'a Ir,
@@ -113,6 +114,63 @@ pub struct ControllerDiff {
     pub items: Vec<ItemChange>,
     /// Only the plans with a change.
     pub plans: Vec<PlanDiff>,
+    /// Shared-row blocks with a change, each once (their rows also stay
+    /// in each plan's `rows`, for the graphs).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub blocks: Vec<BlockDiff>,
+}
+
+/// A change to a `rows` block, reported once with the plans it lands in.
+#[derive(Clone, Debug, Serialize)]
+pub struct BlockDiff {
+    pub name: String,
+    /// Where its changed rows are, per plan: `LOAD E1, E2`.
+    pub plans: Vec<String>,
+    /// The block's changed rows, as the first plan that uses it sees them.
+    pub rows: Vec<RowDiff>,
+}
+
+impl PlanDiff {
+    /// Whether anything changed other than rows of a `rows` block (which
+    /// the block's entry reports once).
+    pub fn changed_outside_blocks(&self) -> bool {
+        self.presence != Presence::Both
+            || !self.states_added.is_empty()
+            || !self.states_removed.is_empty()
+            || !self.moves.is_empty()
+            || self
+                .rows
+                .iter()
+                .any(|r| r.block().is_none() && (r.is_change() || r.renumbered()))
+    }
+}
+
+/// The changed blocks of a controller's plan diffs.
+fn block_diffs(plans: &[PlanDiff]) -> Vec<BlockDiff> {
+    let mut blocks: Vec<BlockDiff> = Vec::new();
+    for p in plans.iter().filter(|p| p.presence == Presence::Both) {
+        let mut here: Vec<(&str, Vec<&RowDiff>)> = Vec::new();
+        for r in p.rows.iter().filter(|r| r.is_change()) {
+            let Some(b) = r.block() else { continue };
+            match here.iter_mut().find(|(n, _)| *n == b) {
+                Some((_, rows)) => rows.push(r),
+                None => here.push((b, vec![r])),
+            }
+        }
+        for (name, rows) in here {
+            let labels: Vec<&str> = rows.iter().map(|r| r.label()).collect();
+            let place = format!("{} {}", p.verb, labels.join(", "));
+            match blocks.iter_mut().find(|b| b.name == name) {
+                Some(b) => b.plans.push(place),
+                None => blocks.push(BlockDiff {
+                    name: name.to_string(),
+                    plans: vec![place],
+                    rows: rows.into_iter().cloned().collect(),
+                }),
+            }
+        }
+    }
+    blocks
 }
 
 /// What changed in one plan: a plain-data picture of both versions, enough
@@ -213,6 +271,7 @@ fn diff_system(old: &Side, new: &Side) -> SystemDiff {
                         name: oc.name.clone(),
                         presence: Presence::Both,
                         items,
+                        blocks: block_diffs(&plans),
                         plans,
                     });
                 }
@@ -252,6 +311,7 @@ fn one_sided_controller(ir: &Ir, c: &crate::ir::Controller, presence: Presence) 
         presence,
         items: Vec::new(),
         plans,
+        blocks: Vec::new(),
     }
 }
 

@@ -45,6 +45,9 @@ pub struct RowView {
     /// 1-based line in its file.
     pub line: u32,
     pub file: String,
+    /// The `rows` block the row was placed from by `use`, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub block: Option<String>,
 }
 
 impl RowView {
@@ -62,6 +65,7 @@ impl RowView {
             otherwise: r.is_otherwise(),
             line: r.line,
             file: ir.files[r.span.file.0 as usize].clone(),
+            block: r.shared.as_ref().map(|s| s.block.clone()),
         }
     }
 
@@ -132,6 +136,19 @@ impl RowDiff {
             .as_ref()
             .or(self.old.as_ref())
             .map_or("", |v| &v.label)
+    }
+
+    /// The `rows` block of the row (on the side it is on, new first).
+    pub fn block(&self) -> Option<&str> {
+        self.new
+            .as_ref()
+            .or(self.old.as_ref())
+            .and_then(|v| v.block.as_deref())
+    }
+
+    /// Its content changed, or it was added or removed.
+    pub fn is_change(&self) -> bool {
+        self.change != RowChange::Same
     }
 
     /// Both sides, with labels that differ: `E3` became `E4`.

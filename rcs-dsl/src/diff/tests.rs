@@ -122,3 +122,27 @@ fn a_plan_past_the_analysis_limit_is_matched_but_gets_no_moves() {
     assert!(p.rows.iter().all(|r| r.change == RowChange::Same));
     assert_eq!(p.rows.iter().filter(|r| r.renumbered()).count(), n - n % 2);
 }
+
+/// A change to a `rows` block is one block entry naming every plan it
+/// lands in, and no plan reports it on its own.
+#[test]
+fn a_changed_block_is_reported_once_with_the_plans_it_affects() {
+    let set = |cond: &str| {
+        format!(
+            "buffer In {{ x: i32 }}\ncontroller A {{\n    reads i: In\n    command GO\n    command JOG\n    rows guard {{\n        * when {cond} -> Error\n    }}\n    plan GO {{\n        E0: *0 when new_command -> S1\n        use guard\n        E2: S1 when i.x > 1 -> Done\n    }}\n    plan JOG {{\n        E0: *0 when new_command -> S1\n        E1: S1 when i.x > 2 -> Done\n        use guard\n    }}\n}}\n"
+        )
+    };
+    let d = run(&set("i.x < 0"), &set("i.x < -5"));
+    let c = &d.systems[0].controllers[0];
+    assert_eq!(c.blocks.len(), 1, "{c:#?}");
+    assert_eq!(c.blocks[0].name, "guard");
+    assert_eq!(c.blocks[0].plans, ["GO E1", "JOG E2"]);
+    assert_eq!(c.blocks[0].rows.len(), 1);
+    assert!(c.plans.iter().all(|p| !p.changed_outside_blocks()), "{c:#?}");
+    // A change outside the block is still the plan's own.
+    let d = run(&set("i.x < 0"), &set("i.x < 0").replace("i.x > 2", "i.x > 3"));
+    let c = &d.systems[0].controllers[0];
+    assert!(c.blocks.is_empty(), "{c:#?}");
+    assert_eq!(c.plans.len(), 1);
+    assert!(c.plans[0].changed_outside_blocks());
+}

@@ -139,6 +139,24 @@ fn check_block(block: &RowsDef, diags: &mut Diagnostics) {
             );
         }
     }
+    for row in &block.rows {
+        let numbered = match &row.from {
+            crate::ast::From::DontCare(Some(n), span) => Some((*n, *span)),
+            crate::ast::From::Except(Some(n), _, span) => Some((*n, *span)),
+            _ => None,
+        };
+        if let Some((n, span)) = numbered {
+            diags.push(
+                Diagnostic::error(
+                    Code::SharedRows,
+                    format!("a row of rows block `{}` is numbered `*{n}`", block.name.text),
+                    span,
+                    "numbered don't-care in a shared block",
+                )
+                .with_help("a shared row takes its number from where it is used: write `*`"),
+            );
+        }
+    }
     for u in &block.uses {
         diags.push(
             Diagnostic::error(

@@ -207,6 +207,20 @@ pub enum DriveError {
     },
 }
 
+impl DriveError {
+    /// The same error, for controller `name`: a command type shared by the
+    /// instances of a controller type names the type; the instance's
+    /// driver names the instance.
+    pub fn for_controller(mut self, name: &str) -> DriveError {
+        match &mut self {
+            DriveError::Unknown { controller, .. }
+            | DriveError::Type { controller, .. }
+            | DriveError::Arity { controller, .. } => *controller = name.to_string(),
+        }
+        self
+    }
+}
+
 /// The `index`-th argument of `verb`, typed. For generated `from_parts`.
 pub fn arg<T: FromValue>(
     controller: &str,

@@ -50,7 +50,12 @@ pub fn markdown(diff: &PlanSetDiff) -> String {
                         RowChange::Changed(parts) => format!("changed ({})", parts.join(", ")),
                         _ => row_word(r).to_string(),
                     };
-                    let _ = writeln!(out, "| {what} | {} | {} |", content(&r.old), content(&r.new));
+                    let _ = writeln!(
+                        out,
+                        "| {what} | {} | {} |",
+                        content(&r.old),
+                        content(&r.new)
+                    );
                 }
                 out.push('\n');
             }

@@ -62,7 +62,11 @@ pub fn text(diff: &PlanSetDiff, color: bool) -> String {
                 let _ = writeln!(
                     out,
                     "    {}",
-                    paint.bold(&format!("rows {} (lands at {})", b.name, b.plans.join("; ")))
+                    paint.bold(&format!(
+                        "rows {} (lands at {})",
+                        b.name,
+                        b.plans.join("; ")
+                    ))
                 );
                 for r in &b.rows {
                     block_row(&mut out, &paint, r);
@@ -80,7 +84,11 @@ pub fn text(diff: &PlanSetDiff, color: bool) -> String {
                 for st in &p.states_removed {
                     let _ = writeln!(out, "      {}", paint.mark('-', &format!("state {st}")));
                 }
-                for r in p.rows.iter().filter(|r| r.block().is_none() || !r.is_change()) {
+                for r in p
+                    .rows
+                    .iter()
+                    .filter(|r| r.block().is_none() || !r.is_change())
+                {
                     row(&mut out, &paint, r);
                 }
                 for m in &p.moves {

@@ -13,7 +13,7 @@ use proc_macro2::TokenStream;
 use quote::quote;
 use rcs_dsl::ir::*;
 
-fn docs(lines: &[String]) -> TokenStream {
+pub(super) fn docs(lines: &[String]) -> TokenStream {
     let lines = lines.iter().map(|l| format!(" {l}"));
     quote!(#(#[doc = #lines])*)
 }
@@ -44,17 +44,28 @@ pub(crate) fn is_zero(e: &Expr) -> bool {
     }
 }
 
-/// `extra`: more items for the module (the scenario driver).
+/// A controller type's shared module (LANGUAGE.md §8): generated from
+/// its first instance, every name in Global Memory and every parameter
+/// read from an `Instance` value.
+pub(crate) struct TypeModule<'a> {
+    pub ty: &'a str,
+    pub group: &'a super::instances::Group,
+}
+
+/// `extra`: more items for the module (the scenario driver). `shared`:
+/// generate the module of the type controller `ci` is the first instance
+/// of, rather than `ci`'s own.
 pub(crate) fn module(
     ir: &Ir,
     names: &Names,
     ci: usize,
     comments: &mut Comments,
     extra: TokenStream,
+    shared: Option<&TypeModule>,
 ) -> TokenStream {
     let c = &ir.controllers[ci];
     let n = &names.ctrls[ci];
-    let name = &c.name;
+    let name = shared.map_or(c.name.as_str(), |t| t.ty);
     let module = &n.module;
     // The controller's doc comment, which usually names it already; the
     // title line only stands in for a missing one.
@@ -308,7 +319,10 @@ pub(crate) fn module(
         sub_names,
         sub_modules,
         sub_handles,
-    } = Wiring::new(ir, names, ci);
+    } = match shared {
+        Some(_) => Wiring::new(ir, names, ci).of_instance(&quote!(inst)),
+        None => Wiring::new(ir, names, ci),
+    };
     // A `reads`/`writes` declaration's doc comment, else the buffer's name.
     let buffer_docs = |list: &[BufferId]| -> Vec<TokenStream> {
         list.iter()
@@ -332,11 +346,22 @@ pub(crate) fn module(
         .vars
         .iter()
         .all(|v| derivable_default(&v.ty) && v.init.as_ref().is_none_or(is_zero));
-    let (vars_derive, vars_default) = if var_defaults_derivable {
+    // A type's shared module: `Default` with the first instance's values
+    // (for `Data::default`), and each instance's own in `Vars::for_instance`.
+    let first = Names {
+        slots: None,
+        ..names.clone()
+    };
+    let (vars_derive, mut vars_default) = if var_defaults_derivable {
         (quote!(Default,), quote!())
     } else {
+        let gen = if shared.is_some() {
+            Gen::new(ir, &first, ci)
+        } else {
+            const_gen
+        };
         let inits = c.vars.iter().map(|v| match &v.init {
-            Some(e) => const_gen.expr(e).ts,
+            Some(e) => gen.expr(e).ts,
             None => zero(names, &v.ty),
         });
         (
@@ -350,6 +375,37 @@ pub(crate) fn module(
             },
         )
     };
+
+    let vars_for_instance = shared.is_some()
+        && names.slots.as_ref().is_some_and(|slots| {
+            c.vars.iter().filter_map(|v| v.init.as_ref()).any(|e| {
+                let mut found = false;
+                e.visit(&mut |x| found |= slots.slot_of.contains_key(&(x as *const Expr as usize)));
+                found
+            })
+        });
+    if vars_for_instance {
+        let per_instance = Names {
+            slots: names.slots.clone().map(|mut s| {
+                s.prefix = quote!(inst.params);
+                s
+            }),
+            ..names.clone()
+        };
+        let gen = Gen::new(ir, &per_instance, ci);
+        let inits = c.vars.iter().map(|v| match &v.init {
+            Some(e) => gen.expr(e).ts,
+            None => zero(names, &v.ty),
+        });
+        vars_default.extend(quote! {
+            impl Vars {
+                /// The variables at an instance's initialisers.
+                pub fn for_instance(inst: &Instance) -> Self {
+                    Self { #(#var_fields: #inits),* }
+                }
+            }
+        });
+    }
 
     // ---- plans
     let plan_fns: Vec<TokenStream> = c
@@ -404,6 +460,15 @@ pub(crate) fn module(
     let old_echoes = if sub_handles.is_empty() {
         quote!()
     } else {
+        let sub_names: Vec<TokenStream> = match shared {
+            Some(_) => (0..sub_handles.len())
+                .map(|k| {
+                    let k = proc_macro2::Literal::usize_unsuffixed(k);
+                    quote!(self.inst.subs[#k])
+                })
+                .collect(),
+            None => sub_names.clone(),
+        };
         quote! {
             fn old_echoes(&self, f: &mut dyn FnMut(&str, u64)) {
                 #(f(#sub_names, self.#sub_handles.link().old_echoes());)*
@@ -439,7 +504,7 @@ pub(crate) fn module(
         pre: pre_jobs,
         post: post_jobs,
         write: status_fields_write,
-    } = super::every_cycle::parts(ir, names, ci, comments);
+    } = super::every_cycle::parts(ir, names, ci, comments, shared.is_some());
     let (decide_call, post_call) = super::index::cycle_steps(&ir.controllers[ci], post_jobs);
 
     let verb_count_lit = proc_macro2::Literal::usize_unsuffixed(verb_count);
@@ -460,13 +525,22 @@ pub(crate) fn module(
         comments.marker("5. Write: status, written buffers, commands sent this cycle.".to_string());
     let step6 = comments.marker("6. Account: state and plan cycle counters, timing.".to_string());
 
+    let Shape {
+        head,
+        vis,
+        inst_field,
+        inst_param,
+        inst_init,
+        gm_name,
+        self_name,
+        data_init,
+    } = shape(names, c, name, shared, vars_for_instance);
     quote! {
         #mod_docs
         pub mod #module {
             use ::rcs_runtime as rt;
 
-            /// The controller's name in Global Memory and in traces.
-            pub const NAME: &str = #name;
+            #head
 
             #command_enum
 
@@ -587,9 +661,10 @@ pub(crate) fn module(
             /// The controller: its data, its plans' bookkeeping and its Global Memory handles.
             #[derive(Debug)]
             pub struct Controller<H: Hooks> {
-                hooks: H,
-                data: Data,
+                #vis hooks: H,
+                #vis data: Data,
                 bk: rt::Bookkeeping,
+                #inst_field
                 command_in: rt::Reader<rt::CommandBuffer<Command>>,
                 status_out: rt::Writer<rt::StatusBuffer>,
                 #(#read_handles: rt::Reader<#read_tys>,)*
@@ -602,17 +677,18 @@ pub(crate) fn module(
                 /// Connect to Global Memory: this controller's command and
                 /// status buffers, its buffers, and its subordinates' command
                 /// buffers (taking their one writer).
-                pub fn new(gm: &rt::GlobalMemory, hooks: H) -> Result<Self, rt::SetupError> {
-                    gm.declare_controller::<Command>(NAME)?;
+                pub fn new(gm: &rt::GlobalMemory, #inst_param hooks: H) -> Result<Self, rt::SetupError> {
+                    gm.declare_controller::<Command>(#gm_name)?;
                     #(gm.declare::<#read_tys>(#read_names)?;)*
                     #(gm.declare::<#write_tys>(#write_names)?;)*
                     #every_cycle_declares
                     Ok(Self {
                         hooks,
-                        data: Data::default(),
+                        data: #data_init,
                         bk: rt::Bookkeeping::new(#verb_count_lit),
-                        command_in: gm.command_reader(NAME)?,
-                        status_out: gm.status_writer(NAME)?,
+                        command_in: gm.command_reader(#gm_name)?,
+                        status_out: gm.status_writer(#gm_name)?,
+                        #inst_init
                         #(#read_handles: gm.reader(#read_names)?,)*
                         #(#write_handles: gm.writer(#write_names)?,)*
                         #(#sub_handles: rt::Subordinate::connect(gm, #sub_names)?,)*
@@ -654,7 +730,7 @@ pub(crate) fn module(
             }
 
             impl<H: Hooks + 'static> rt::Controller for Controller<H> {
-                fn name(&self) -> &str { NAME }
+                fn name(&self) -> &str { #self_name }
 
                 fn cycle(&mut self, ctx: &rt::CycleContext) {
                     #step1
@@ -697,6 +773,103 @@ pub(crate) fn module(
     }
 }
 
+/// What differs between a controller's own module and a type's shared one.
+struct Shape {
+    /// `NAME`, or the `Instance` and `Params` structs.
+    head: TokenStream,
+    /// The visibility of `hooks` and `data` (an instance's driver, in the
+    /// instance's module, reaches them).
+    vis: TokenStream,
+    inst_field: TokenStream,
+    inst_param: TokenStream,
+    inst_init: TokenStream,
+    /// The name in `new`, and in methods.
+    gm_name: TokenStream,
+    self_name: TokenStream,
+    data_init: TokenStream,
+}
+
+fn shape(
+    names: &Names,
+    c: &Controller,
+    name: &str,
+    shared: Option<&TypeModule>,
+    vars_for_instance: bool,
+) -> Shape {
+    let Some(t) = shared else {
+        return Shape {
+            head: quote! {
+                /// The controller's name in Global Memory and in traces.
+                pub const NAME: &str = #name;
+            },
+            vis: quote!(),
+            inst_field: quote!(),
+            inst_param: quote!(),
+            inst_init: quote!(),
+            gm_name: quote!(NAME),
+            self_name: quote!(NAME),
+            data_init: quote!(Data::default()),
+        };
+    };
+    let (r, w, s) = (
+        proc_macro2::Literal::usize_unsuffixed(c.reads.len()),
+        proc_macro2::Literal::usize_unsuffixed(c.writes.len()),
+        proc_macro2::Literal::usize_unsuffixed(c.subordinates.len()),
+    );
+    let fields: Vec<Ident> = (0..t.group.slots.len())
+        .map(super::names::SlotNames::field)
+        .collect();
+    let tys: Vec<TokenStream> = t
+        .group
+        .slots
+        .iter()
+        .map(|s| rust_type(names, &s.ty))
+        .collect();
+    let params_doc = format!(
+        " The values the instances of `{}` differ in: its parameters where its plans use them.",
+        t.ty
+    );
+    let inst_doc = format!(
+        " One instance of `{}`: its names in Global Memory and its parameters.",
+        t.ty
+    );
+    Shape {
+        head: quote! {
+            #[doc = #inst_doc]
+            #[derive(Clone, Copy, Debug, PartialEq)]
+            pub struct Instance {
+                /// The instance's name: its command and status buffers, traces.
+                pub name: &'static str,
+                /// The Global Memory buffers bound to its `reads`, in order.
+                pub reads: [&'static str; #r],
+                /// The Global Memory buffers bound to its `writes`, in order.
+                pub writes: [&'static str; #w],
+                /// The controllers bound to its `subordinates`, in order.
+                pub subs: [&'static str; #s],
+                /// Its parameters.
+                pub params: Params,
+            }
+            #[doc = #params_doc]
+            #[derive(Clone, Copy, Debug, PartialEq)]
+            pub struct Params { #(pub #fields: #tys),* }
+        },
+        vis: quote!(pub(super)),
+        inst_field: quote!(inst: Instance,),
+        inst_param: quote!(inst: Instance,),
+        inst_init: quote!(inst,),
+        gm_name: quote!(inst.name),
+        self_name: quote!(self.inst.name),
+        data_init: if vars_for_instance {
+            quote!(Data {
+                vars: Vars::for_instance(&inst),
+                ..Data::default()
+            })
+        } else {
+            quote!(Data::default())
+        },
+    }
+}
+
 /// A controller's Global Memory wiring, in declaration order: its `reads`
 /// and `writes` buffers (field in `Reads`/`Writes`, Rust type, name in
 /// Global Memory, handle field) and its subordinates (name, module, handle
@@ -704,13 +877,15 @@ pub(crate) fn module(
 pub(crate) struct Wiring<'a> {
     pub read_fields: Vec<Ident>,
     pub read_tys: Vec<TokenStream>,
-    pub read_names: Vec<&'a str>,
+    /// Names in Global Memory: string literals, or in a type's shared
+    /// module the instance's (`inst.reads[0]`, see [`Wiring::of_instance`]).
+    pub read_names: Vec<TokenStream>,
     pub read_handles: Vec<Ident>,
     pub write_fields: Vec<Ident>,
     pub write_tys: Vec<TokenStream>,
-    pub write_names: Vec<&'a str>,
+    pub write_names: Vec<TokenStream>,
     pub write_handles: Vec<Ident>,
-    pub sub_names: Vec<&'a str>,
+    pub sub_names: Vec<TokenStream>,
     pub sub_modules: Vec<&'a Ident>,
     pub sub_handles: Vec<Ident>,
 }
@@ -729,9 +904,12 @@ impl<'a> Wiring<'a> {
                 .map(|b| rust_type(names, &Type::Buffer(ir.buffers[b.index()].ty)))
                 .collect()
         };
-        let gm_names = |list: &[BufferId]| -> Vec<&'a str> {
+        let gm_names = |list: &[BufferId]| -> Vec<TokenStream> {
             list.iter()
-                .map(|b| ir.buffers[b.index()].name.as_str())
+                .map(|b| {
+                    let n = ir.buffers[b.index()].name.as_str();
+                    quote!(#n)
+                })
                 .collect()
         };
         let handles = |prefix: &str, ids: &[Ident]| -> Vec<Ident> {
@@ -752,7 +930,10 @@ impl<'a> Wiring<'a> {
             sub_names: c
                 .subordinates
                 .iter()
-                .map(|s| ir.controllers[s.index()].name.as_str())
+                .map(|s| {
+                    let n = ir.controllers[s.index()].name.as_str();
+                    quote!(#n)
+                })
                 .collect(),
             sub_modules: c
                 .subordinates
@@ -760,5 +941,21 @@ impl<'a> Wiring<'a> {
                 .map(|s| &names.ctrls[s.index()].module)
                 .collect(),
         }
+    }
+
+    /// The wiring of a type's shared module: every name in Global Memory
+    /// read from the instance, `#inst.reads[k]` and so on.
+    pub fn of_instance(mut self, inst: &TokenStream) -> Self {
+        let from = |list: &mut Vec<TokenStream>, field: &str| {
+            let field = quote::format_ident!("{}", field);
+            for (k, n) in list.iter_mut().enumerate() {
+                let k = proc_macro2::Literal::usize_unsuffixed(k);
+                *n = quote!(#inst.#field[#k]);
+            }
+        };
+        from(&mut self.read_names, "reads");
+        from(&mut self.write_names, "writes");
+        from(&mut self.sub_names, "subs");
+        self
     }
 }

@@ -73,7 +73,22 @@ pub(crate) fn type_conversions(ir: &Ir, names: &Names) -> TokenStream {
 
 /// `DrivenCommand`, `ScriptedHooks` and `Driver` for controller `ci`
 /// (inside its module).
+/// Which parts of a controller's driver to write.
+#[derive(Clone, Copy, PartialEq)]
+pub(crate) enum DriverPart {
+    /// A controller's own module: all of it.
+    Whole,
+    /// A type's shared module: `DrivenCommand` for its one `Command`.
+    TypeCommand,
+    /// An instance's module: all but `DrivenCommand`, with its `INSTANCE`.
+    Instance,
+}
+
 pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStream {
+    driver_parts(ir, names, ci, DriverPart::Whole)
+}
+
+pub(crate) fn driver_parts(ir: &Ir, names: &Names, ci: usize, part: DriverPart) -> TokenStream {
     let dv = dv();
     let c = &ir.controllers[ci];
     let n = &names.ctrls[ci];
@@ -130,6 +145,33 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
                 }
             }
         }
+    };
+
+    let command_impl = match part {
+        DriverPart::Whole => command_impl,
+        DriverPart::TypeCommand => {
+            // The type's `Command` has no `NAME`: its errors name the type
+            // (an instance's driver renames them, `for_controller`).
+            let ty = c
+                .instance_of
+                .as_ref()
+                .map_or(c.name.as_str(), |i| i.ty.as_str());
+            return quote! {
+                const NAME: &str = #ty;
+                #command_impl
+            };
+        }
+        DriverPart::Instance => quote!(),
+    };
+    let (new_controller, from_parts) = match part {
+        DriverPart::Instance => (
+            quote!(Controller::new(&gm, INSTANCE, ScriptedHooks::default())?),
+            quote!(<Command as #dv::DrivenCommand>::from_parts(verb, args).map_err(|e| e.for_controller(NAME))?),
+        ),
+        _ => (
+            quote!(Controller::new(&gm, ScriptedHooks::default())?),
+            quote!(<Command as #dv::DrivenCommand>::from_parts(verb, args)?),
+        ),
     };
 
     // ---- ScriptedHooks
@@ -329,7 +371,7 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
             /// A fresh controller: vars at their initialisers, every buffer zero.
             pub fn new() -> Result<Self, rt::SetupError> {
                 let gm = rt::GlobalMemory::new();
-                let controller = Controller::new(&gm, ScriptedHooks::default())?;
+                let controller = #new_controller;
                 Ok(Self {
                     controller,
                     operator: rt::Operator::connect(&gm, NAME)?,
@@ -351,7 +393,7 @@ pub(crate) fn controller_driver(ir: &Ir, names: &Names, ci: usize) -> TokenStrea
             fn name(&self) -> &str { NAME }
 
             fn command(&mut self, verb: &str, args: &[#dv::Value]) -> Result<u32, #dv::DriveError> {
-                let command = <Command as #dv::DrivenCommand>::from_parts(verb, args)?;
+                let command = #from_parts;
                 Ok(self.operator.command(command))
             }
 

@@ -48,7 +48,7 @@ fn publishing_subs<'a>(
     ir: &'a Ir,
     names: &'a Names,
     ci: usize,
-) -> Vec<(&'a Ident, &'a Ident, &'a str)> {
+) -> Vec<(&'a Ident, &'a Ident, &'a str, usize)> {
     let c = &ir.controllers[ci];
     c.subordinates
         .iter()
@@ -59,12 +59,26 @@ fn publishing_subs<'a>(
                 &names.ctrls[ci].subs[i],
                 &names.ctrls[s.index()].module,
                 ir.controller(*s).name.as_str(),
+                i,
             )
         })
         .collect()
 }
 
-pub(crate) fn parts(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments) -> Parts {
+/// `shared`: for a type's shared module, where names in Global Memory come
+/// from the `inst` argument of `new`.
+pub(crate) fn parts(
+    ir: &Ir,
+    names: &Names,
+    ci: usize,
+    comments: &mut Comments,
+    shared: bool,
+) -> Parts {
+    let own_name = if shared {
+        quote!(inst.name)
+    } else {
+        quote!(NAME)
+    };
     let c = &ir.controllers[ci];
     let n = &names.ctrls[ci];
     let mut p = Parts::default();
@@ -137,10 +151,12 @@ pub(crate) fn parts(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments) 
         }
         p.handles
             .extend(quote!(status_fields_out: rt::Writer<StatusFields>,));
-        p.declares
-            .extend(quote!(gm.declare::<StatusFields>(&rt::status_fields_buffer_name(NAME))?;));
-        p.inits
-            .extend(quote!(status_fields_out: gm.writer(&rt::status_fields_buffer_name(NAME))?,));
+        p.declares.extend(
+            quote!(gm.declare::<StatusFields>(&rt::status_fields_buffer_name(#own_name))?;),
+        );
+        p.inits.extend(
+            quote!(status_fields_out: gm.writer(&rt::status_fields_buffer_name(#own_name))?,),
+        );
         p.write.extend(quote! {
             self.status_fields_out.write(
                 StatusFields { #(#fields: self.data.vars.#fields),* },
@@ -152,9 +168,19 @@ pub(crate) fn parts(ir: &Ir, names: &Names, ci: usize, comments: &mut Comments) 
     // ---- the subordinates' status fields
     let subs = publishing_subs(ir, names, ci);
     if !subs.is_empty() {
-        let fields: Vec<&Ident> = subs.iter().map(|(f, _, _)| *f).collect();
-        let modules: Vec<&Ident> = subs.iter().map(|(_, m, _)| *m).collect();
-        let sub_names: Vec<&str> = subs.iter().map(|(_, _, s)| *s).collect();
+        let fields: Vec<&Ident> = subs.iter().map(|(f, _, _, _)| *f).collect();
+        let modules: Vec<&Ident> = subs.iter().map(|(_, m, _, _)| *m).collect();
+        let sub_names: Vec<TokenStream> = subs
+            .iter()
+            .map(|(_, _, s, k)| {
+                if shared {
+                    let k = proc_macro2::Literal::usize_unsuffixed(*k);
+                    quote!(inst.subs[#k])
+                } else {
+                    quote!(#s)
+                }
+            })
+            .collect();
         let handles: Vec<Ident> = fields.iter().map(|f| prefixed("fields", f)).collect();
         p.items.extend(quote! {
             /// The subordinates' status fields as they last published them, whatever serial they echo.
@@ -222,9 +248,12 @@ pub(crate) fn driver_parts(
     }
     let dv = quote!(::rcs_runtime::driver);
     let c = &ir.controllers[ci];
-    let handles: Vec<Ident> = subs.iter().map(|(f, _, _)| prefixed("fields", f)).collect();
-    let modules: Vec<&Ident> = subs.iter().map(|(_, m, _)| *m).collect();
-    let sub_names: Vec<&str> = subs.iter().map(|(_, _, s)| *s).collect();
+    let handles: Vec<Ident> = subs
+        .iter()
+        .map(|(f, _, _, _)| prefixed("fields", f))
+        .collect();
+    let modules: Vec<&Ident> = subs.iter().map(|(_, m, _, _)| *m).collect();
+    let sub_names: Vec<&str> = subs.iter().map(|(_, _, s, _)| *s).collect();
     let arms = c.subordinates.iter().filter_map(|s| {
         let sc = ir.controller(*s);
         // Only subordinates that publish status fields get an arm.

@@ -245,6 +245,13 @@ impl Gen<'_> {
     }
 
     pub fn expr(&self, e: &Expr) -> Code {
+        if let Some(slots) = &self.names.slots {
+            if let Some(i) = slots.slot_of.get(&(e as *const Expr as usize)) {
+                let prefix = &slots.prefix;
+                let field = super::names::SlotNames::field(*i);
+                return Code::atom(quote!(#prefix.#field));
+            }
+        }
         match &e.kind {
             ExprKind::Int(v) => int_lit(*v, &e.ty),
             ExprKind::Float(v) => float_lit(*v, &e.ty),

@@ -10,6 +10,7 @@ mod driver;
 mod every_cycle;
 mod expr;
 mod index;
+mod instances;
 mod names;
 mod plan;
 mod process;
@@ -66,7 +67,15 @@ impl Comments {
 
 /// The generated Rust of one plan set, as the text of `rust/<system>.rs`.
 pub fn system_module(ir: &Ir, options: &crate::Options) -> String {
-    let names = names::Names::new(ir);
+    let mut names = names::Names::new(ir);
+    // Instances of one controller type share its module (LANGUAGE.md §8).
+    let sharing = instances::Sharing::of(ir);
+    for g in &sharing.groups {
+        for &m in &g.members {
+            names.ctrls[m].shared = true;
+        }
+    }
+    let type_modules = instances::type_modules(&names, &sharing);
     let mut comments = Comments { texts: Vec::new() };
     let conversions = if options.driver {
         driver::type_conversions(ir, &names)
@@ -93,12 +102,52 @@ pub fn system_module(ir: &Ir, options: &crate::Options) -> String {
     let types = types::module(ir, &names, serde.as_ref(), conversions);
     let controllers: Vec<TokenStream> = (0..ir.controllers.len())
         .map(|ci| {
-            let extra = if options.driver {
-                driver::controller_driver(ir, &names, ci)
-            } else {
-                TokenStream::new()
+            let Some(g) = sharing.group_of[ci] else {
+                let extra = if options.driver {
+                    driver::controller_driver(ir, &names, ci)
+                } else {
+                    TokenStream::new()
+                };
+                return controller::module(ir, &names, ci, &mut comments, extra, None);
             };
-            controller::module(ir, &names, ci, &mut comments, extra)
+            let group = &sharing.groups[g];
+            let mut out = TokenStream::new();
+            if group.members[0] == ci {
+                let shared = instances::type_names(
+                    ir,
+                    &names,
+                    &sharing,
+                    &type_modules,
+                    ci,
+                    Some(quote!(self.inst.params)),
+                );
+                let extra = if options.driver {
+                    driver::driver_parts(ir, &shared, ci, driver::DriverPart::TypeCommand)
+                } else {
+                    TokenStream::new()
+                };
+                let ty = controller::TypeModule {
+                    ty: &group.ty,
+                    group,
+                };
+                out.extend(controller::module(
+                    ir,
+                    &shared,
+                    ci,
+                    &mut comments,
+                    extra,
+                    Some(&ty),
+                ));
+            }
+            out.extend(instances::instance_module(
+                ir,
+                &names,
+                &sharing,
+                &type_modules,
+                ci,
+                options.driver,
+            ));
+            out
         })
         .collect();
     let mut system = system::system(ir, &names);

@@ -5,22 +5,26 @@ use crate::ident::{camel, distinct, ident, screaming, snake};
 use proc_macro2::Ident;
 use rcs_dsl::ir::Ir;
 
+#[derive(Clone)]
 pub(crate) struct EnumNames {
     pub ty: Ident,
     pub variants: Vec<Ident>,
 }
 
+#[derive(Clone)]
 pub(crate) struct BufferNames {
     pub ty: Ident,
     pub fields: Vec<Ident>,
 }
 
+#[derive(Clone)]
 pub(crate) struct PlanNames {
     pub func: Ident,
     pub state_ty: Ident,
     pub states: Vec<Ident>,
 }
 
+#[derive(Clone)]
 pub(crate) struct CtrlNames {
     pub module: Ident,
     pub commands: Vec<Ident>,
@@ -37,8 +41,12 @@ pub(crate) struct CtrlNames {
     /// Field of `Subs` per subordinate, parallel to `subordinates`.
     pub subs: Vec<Ident>,
     pub plans: Vec<PlanNames>,
+    /// An instance whose code is its type's module (LANGUAGE.md §8):
+    /// built by its module's `new`, not `Controller::new`.
+    pub shared: bool,
 }
 
+#[derive(Clone)]
 pub(crate) struct Names {
     pub enums: Vec<EnumNames>,
     pub buffers: Vec<BufferNames>,
@@ -49,6 +57,25 @@ pub(crate) struct Names {
     /// every type that can sit in a buffer also travels over the Zenoh
     /// bridge (serde derives and a schema hash, [`super::schema`]).
     pub wire: bool,
+    /// While a type's shared module is generated: the literals that are
+    /// parameters of its instances ([`super::instances`]).
+    pub slots: Option<SlotNames>,
+}
+
+/// Literals of a type's template that each instance gives: the template's
+/// expression (by address) → its field of `Params`, read through `prefix`
+/// (`self.inst.params`, or `inst.params` where there is no `self`).
+#[derive(Clone)]
+pub(crate) struct SlotNames {
+    pub slot_of: std::collections::BTreeMap<usize, usize>,
+    pub prefix: proc_macro2::TokenStream,
+}
+
+impl SlotNames {
+    /// The field of slot `i` of `Params`.
+    pub fn field(i: usize) -> Ident {
+        ident(&format!("k{i}"))
+    }
 }
 
 fn idents(v: Vec<String>) -> Vec<Ident> {
@@ -194,6 +221,7 @@ impl Names {
                         &[],
                     )),
                     plans,
+                    shared: false,
                 }
             })
             .collect();
@@ -208,6 +236,7 @@ impl Names {
             ctrls,
             gm_buffers,
             wire: rcs_dsl::placement::Placement::of(ir).is_distributed(),
+            slots: None,
         }
     }
 }

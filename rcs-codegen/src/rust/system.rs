@@ -140,7 +140,11 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
             } else {
                 quote!(hooks.#m)
             };
-            quote!(exec.add(Box::new(#m::Controller::new(&gm, #arg)?))?;)
+            if names.ctrls[c.index()].shared {
+                quote!(exec.add(Box::new(#m::new(&gm, #arg)?))?;)
+            } else {
+                quote!(exec.add(Box::new(#m::Controller::new(&gm, #arg)?))?;)
+            }
         });
         quote! {{
             let mut exec = rt::Executive::new(rt::ExecutiveConfig::new(#name, ::core::time::Duration::from_nanos(#period)))?;

@@ -73,5 +73,9 @@ pub(super) fn type_page(site: &Site, set: &SetDoc, ty: &str, instances: &[&Contr
         );
     }
     body.push_str("</table>\n");
-    page(&format!("{} — controller type {ty}", ir.system), root, &body)
+    page(
+        &format!("{} — controller type {ty}", ir.system),
+        root,
+        &body,
+    )
 }

@@ -48,9 +48,15 @@ pub fn instances(n: usize) -> String {
         .replace("@IO@", "io")
         .replace("@OUT@", "out")
         .replace("@ID@", "id");
-    let _ = write!(out, "\n/// One axis, written once.\ncontroller type Axis(id: u16) {{\n{body}}}\n\n");
+    let _ = write!(
+        out,
+        "\n/// One axis, written once.\ncontroller type Axis(id: u16) {{\n{body}}}\n\n"
+    );
     for i in 0..n {
-        let _ = writeln!(out, "controller A{i} = Axis(id: {i}) {{ io: io{i}, out: out{i} }}");
+        let _ = writeln!(
+            out,
+            "controller A{i} = Axis(id: {i}) {{ io: io{i}, out: out{i} }}"
+        );
     }
     out
 }

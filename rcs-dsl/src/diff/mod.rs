@@ -40,7 +40,6 @@ pub use findings::Finding;
 pub use precedence::{Effect, Move};
 pub use rows::{RowChange, RowDiff, RowView};
 
-
 /// One side of a diff: a checked plan set.
 pub struct Side<'a> {
     pub ir: &'a Ir,

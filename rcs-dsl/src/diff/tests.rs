@@ -138,9 +138,15 @@ fn a_changed_block_is_reported_once_with_the_plans_it_affects() {
     assert_eq!(c.blocks[0].name, "guard");
     assert_eq!(c.blocks[0].plans, ["GO E1", "JOG E2"]);
     assert_eq!(c.blocks[0].rows.len(), 1);
-    assert!(c.plans.iter().all(|p| !p.changed_outside_blocks()), "{c:#?}");
+    assert!(
+        c.plans.iter().all(|p| !p.changed_outside_blocks()),
+        "{c:#?}"
+    );
     // A change outside the block is still the plan's own.
-    let d = run(&set("i.x < 0"), &set("i.x < 0").replace("i.x > 2", "i.x > 3"));
+    let d = run(
+        &set("i.x < 0"),
+        &set("i.x < 0").replace("i.x > 2", "i.x > 3"),
+    );
     let c = &d.systems[0].controllers[0];
     assert!(c.blocks.is_empty(), "{c:#?}");
     assert_eq!(c.plans.len(), 1);

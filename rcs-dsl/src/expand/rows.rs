@@ -149,7 +149,10 @@ fn check_block(block: &RowsDef, diags: &mut Diagnostics) {
             diags.push(
                 Diagnostic::error(
                     Code::SharedRows,
-                    format!("a row of rows block `{}` is numbered `*{n}`", block.name.text),
+                    format!(
+                        "a row of rows block `{}` is numbered `*{n}`",
+                        block.name.text
+                    ),
                     span,
                     "numbered don't-care in a shared block",
                 )

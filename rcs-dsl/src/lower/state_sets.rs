@@ -159,3 +159,91 @@ impl Cx<'_, '_> {
         );
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! Rows placed by `use NAME` (marked here by hand, as `expand` marks
+    //! them): their `from` names only the plan's own states.
+
+    use crate::ast;
+    use crate::diagnostic::Diagnostics;
+    use crate::ir::{From, Ir, StateId};
+    use crate::lint::LintLevels;
+    use crate::PlanSet;
+
+    const TEXT: &str = "buffer In { a: bool, b: bool }
+controller C {
+    reads i: In
+    command GO
+    error TIMEOUT
+    plan GO {
+        E0: *0 when new_command -> Running
+        E1: Aborting when i.a -> Done
+        E2: * except Aborting when i.b -> Error(TIMEOUT)
+        E3: Running | Aborting when state_cycles > 9 -> Done
+        E4: Running when i.a && !i.b -> Done
+    }
+}
+";
+
+    /// Lower and check `TEXT` with rows E1–E3 of plan GO marked as shared
+    /// (or not): the IR and every diagnostic's code.
+    fn lower(shared: bool) -> (Ir, Vec<String>) {
+        let set = PlanSet::from_texts("t", [("t.rcs", TEXT)], None);
+        let mut diags = Diagnostics::new();
+        let mut parsed = crate::parse(&set, &mut diags).expect("parses");
+        for item in &mut parsed.files[0].items {
+            let ast::Item::Controller(c) = item else {
+                continue;
+            };
+            for e in &mut c.entries {
+                let ast::EntryKind::Plan(p) = &mut e.kind else {
+                    continue;
+                };
+                for r in p.rows.iter_mut().skip(1).take(3).filter(|_| shared) {
+                    r.shared = Some(Box::new(ast::SharedOrigin {
+                        block: ast::Name {
+                            text: "on_abort".into(),
+                            span: r.span,
+                        },
+                        use_span: r.span,
+                    }));
+                }
+            }
+        }
+        let ir = crate::lower_files(&set, parsed, &mut diags).expect("lowers");
+        crate::checks::run(&ir, &LintLevels::default(), &set.sources, &mut diags);
+        let codes = diags.iter().map(|d| d.code.name().to_string()).collect();
+        (ir, codes)
+    }
+
+    #[test]
+    fn a_state_named_only_in_shared_froms_is_not_a_state_of_the_plan() {
+        let (ir, codes) = lower(true);
+        let plan = &ir.controllers[0].plans[0];
+        let names: Vec<&str> = plan.states.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(names, ["S0", "Running"]);
+        let running = StateId(1);
+        // Each pattern keeps only the plan's states; a row left with none
+        // never applies.
+        assert_eq!(plan.rows[1].from, From::States(vec![]));
+        assert_eq!(plan.rows[2].from, From::Except(None, vec![]));
+        assert_eq!(plan.rows[3].from, From::States(vec![running]));
+        assert!(!plan.rows[1].applies_in(running) && !plan.rows[1].applies_in(StateId::S0));
+        assert!(plan.rows[2].applies_in(running) && plan.rows[3].applies_in(running));
+        assert!(codes.is_empty(), "no finding at all: {codes:?}");
+    }
+
+    #[test]
+    fn the_same_rows_written_in_the_plan_make_the_state_its_own() {
+        let (ir, codes) = lower(false);
+        let plan = &ir.controllers[0].plans[0];
+        let names: Vec<&str> = plan.states.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(names, ["S0", "Running", "Aborting"]);
+        assert_eq!(
+            plan.rows[3].from,
+            From::States(vec![StateId(1), StateId(2)])
+        );
+        assert_eq!(codes, ["unreachable_state"]);
+    }
+}

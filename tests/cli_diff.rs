@@ -232,5 +232,16 @@ fn state_sets_are_shown_as_written_and_drawn_per_state() {
         assert!(dot.contains(&edge), "{edge}\n{dot}");
     }
     assert!(dot.contains("\"*5\" -> \"Error\""), "{dot}");
+    // The states of a set in another order mean the same: no change.
+    let old = std::fs::read_to_string(case.join("new/cell.rcs")).unwrap();
+    let new = old.replace("Starting | Execute", "Execute | Starting");
+    assert_ne!(old, new);
+    let dir = scratch(
+        "diff-state-sets",
+        &[("old/c.rcs", &old), ("new/c.rcs", &new)],
+    );
+    let out = rcsc_in(&dir, &["diff", "old", "new"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+    assert!(out.stdout.is_empty(), "{}", text(&out.stdout));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -83,6 +83,18 @@ impl RowView {
         }
     }
 
+    /// The state pattern by meaning: a set's or an `except` list's states
+    /// in name order, so that `B | A` is no change from `A | B`.
+    pub fn pattern(&self) -> String {
+        let (head, list) = match self.from.strip_prefix("* except ") {
+            Some(out) => ("* except ", out),
+            None => ("", self.from.as_str()),
+        };
+        let mut names: Vec<&str> = list.split(" | ").collect();
+        names.sort_unstable();
+        format!("{head}{}", names.join(" | "))
+    }
+
     /// Whether the row applies in the state named `state`.
     pub fn covers_name(&self, state: &str) -> bool {
         match self.from.strip_prefix("* except ") {
@@ -176,8 +188,15 @@ pub(crate) fn match_rows(old: &[RowView], new: &[RowView]) -> Vec<(usize, usize)
         |v| format!("{}\u{0}{}", v.label, v.content()),
         |v| v.content(),
         |v| v.label.clone(),
-        |v| format!("{}\u{0}{}", v.from, v.condition),
-        |v| format!("{}\u{0}{}\u{0}{}", v.from, v.target, v.jobs.join("\u{0}")),
+        |v| format!("{}\u{0}{}", v.pattern(), v.condition),
+        |v| {
+            format!(
+                "{}\u{0}{}\u{0}{}",
+                v.pattern(),
+                v.target,
+                v.jobs.join("\u{0}")
+            )
+        },
     ];
     let mut old_of: Vec<Option<usize>> = vec![None; new.len()];
     let mut new_of: Vec<Option<usize>> = vec![None; old.len()];
@@ -205,7 +224,7 @@ pub(crate) fn match_rows(old: &[RowView], new: &[RowView]) -> Vec<(usize, usize)
 
 fn change(o: &RowView, n: &RowView) -> RowChange {
     let mut parts = Vec::new();
-    if o.from != n.from {
+    if o.pattern() != n.pattern() {
         parts.push("from");
     }
     if o.condition != n.condition {

@@ -206,3 +206,42 @@ fn the_readme_example_is_what_rcsc_diff_prints() {
     );
     assert_eq!(text(&out.stdout).trim_end(), block);
 }
+
+/// A row that becomes a state set, and a `*` row that becomes `except`:
+/// the diff shows each pattern as written, and its graph draws the set row
+/// from each of its states.
+#[test]
+fn state_sets_are_shown_as_written_and_drawn_per_state() {
+    let dir = scratch("diff-state-sets", &[]);
+    let graphs = dir.join("g");
+    let case = Path::new("tests/data/diff/state_sets");
+    let out = rcsc_in(
+        case,
+        &["diff", "old", "new", "--graphs", graphs.to_str().unwrap()],
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+    let shown = text(&out.stdout);
+    assert!(
+        shown.contains("from: Starting → Starting | Execute"),
+        "{shown}"
+    );
+    assert!(shown.contains("from: * → * except Holding"), "{shown}");
+    let dot = std::fs::read_to_string(graphs.join("CELL.RUN.dot")).unwrap();
+    for from in ["Starting", "Execute"] {
+        let edge = format!("\"{from}\" -> \"Holding\" [label=<<FONT COLOR=\"darkorange\">~ E2:");
+        assert!(dot.contains(&edge), "{edge}\n{dot}");
+    }
+    assert!(dot.contains("\"*5\" -> \"Error\""), "{dot}");
+    // The states of a set in another order mean the same: no change.
+    let old = std::fs::read_to_string(case.join("new/cell.rcs")).unwrap();
+    let new = old.replace("Starting | Execute", "Execute | Starting");
+    assert_ne!(old, new);
+    let dir = scratch(
+        "diff-state-sets",
+        &[("old/c.rcs", &old), ("new/c.rcs", &new)],
+    );
+    let out = rcsc_in(&dir, &["diff", "old", "new"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+    assert!(out.stdout.is_empty(), "{}", text(&out.stdout));
+    let _ = std::fs::remove_dir_all(&dir);
+}

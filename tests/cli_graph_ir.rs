@@ -337,3 +337,55 @@ fn build_accepts_out_as_well_as_out_dir() {
     assert!(out_dir.join("graphs/GX/RUN.dot").is_file());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A state set is drawn as one edge per state, each labelled with the
+/// row; an `except` row as its dashed `*N` node saying what it leaves out;
+/// `rcsc ir` writes both patterns with the plan's state ids.
+#[test]
+fn state_sets_and_except_in_graph_and_ir() {
+    let set = "tests/data/ok/0210_state_sets";
+    let out = rcsc(&["graph", set, "--plan", "CELL.RUN"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let dot = text(&out.stdout);
+    let e2: Vec<&str> = dot
+        .lines()
+        .filter(|l| l.contains("id=\"edge-E2\""))
+        .collect();
+    assert_eq!(e2.len(), 2, "one edge per state of the set:\n{dot}");
+    assert!(e2[0]
+        .trim_start()
+        .starts_with("\"Starting\" -> \"Holding\""));
+    assert!(e2[1].trim_start().starts_with("\"Execute\" -> \"Holding\""));
+    assert!(e2.iter().all(|l| l.contains("label=<E2: line.jam")));
+    let node = dot
+        .lines()
+        .find(|l| l.trim_start().starts_with("\"*5\" [id=\"node-any-E5\""))
+        .unwrap_or_else(|| panic!("a *5 node:\n{dot}"));
+    assert!(
+        node.contains("style=dashed") && node.contains("except Holding"),
+        "{node}"
+    );
+    assert!(dot.contains("\"*5\" -> \"Error\""), "{dot}");
+    assert!(!dot.contains("\"Holding\" -> \"Error\""), "{dot}");
+
+    let out = rcsc(&["ir", set, "--format", "json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
+    let plan = &v["controllers"][0]["plans"][0];
+    let states: Vec<&str> = plan["states"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(states, ["S0", "Starting", "Execute", "Holding"]);
+    assert_eq!(
+        plan["rows"][2]["from"],
+        serde_json::json!({ "states": [1, 2] })
+    );
+    assert_eq!(
+        plan["rows"][5]["from"],
+        serde_json::json!({ "except": [5, [3]] })
+    );
+    assert_eq!(plan["rows"][1]["from"], serde_json::json!({ "state": 1 }));
+}

@@ -320,3 +320,37 @@ fn shared_plans_and_forwarding_pass_their_scenarios_with_every_row_covered() {
         "a shared plan is named by its verbs:\n{stdout}"
     );
 }
+
+/// State sets and `except` (tests/data/ok/0210): the set row fires in both
+/// of its states, the `except` row times out of Starting and Execute but
+/// never fires in Holding; both backends agree, every row covered.
+#[test]
+fn state_sets_and_except_pass_their_scenarios_on_both_backends() {
+    let set = "tests/data/ok/0210_state_sets";
+    let target = Path::new(env!("CARGO_TARGET_TMPDIR")).join("rcsc-test-driver-sets");
+    let run = |backend: &str| {
+        let out = rcsc(&[
+            "test",
+            set,
+            "--coverage",
+            "--backend",
+            backend,
+            "--target-dir",
+            target.to_str().unwrap(),
+        ]);
+        let stdout = text(&out.stdout);
+        assert_eq!(out.status.code(), Some(0), "{stdout}{}", text(&out.stderr));
+        stdout
+    };
+    let interp = run("interp");
+    assert_eq!(
+        interp.lines().filter(|l| l.ends_with("... ok")).count(),
+        scenario_count(set)
+    );
+    assert_full_coverage(&interp, 1);
+    assert_eq!(
+        run("compiled"),
+        interp,
+        "identical reports on both backends"
+    );
+}

@@ -97,6 +97,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     ));
     std::fs::write(out.join("sets.rs"), includes)?;
 
+    // The folders themselves: a plan set added to either is compiled in
+    // (`Config::compile` names only the sets that were there).
+    println!("cargo::rerun-if-changed=../../plans");
+    println!("cargo::rerun-if-changed=../../tests/data/ok");
     println!("cargo::rerun-if-changed=c/pr_template.c");
     cc::Build::new()
         .file("c/pr_template.c")

@@ -3,7 +3,9 @@
 //!
 //! Notation (Figure 13, Appendix C): states are circles, `Done` a double
 //! circle, `Error` a red octagon; each don't-care row gets its own dashed
-//! `*N` pseudo-node with an edge to its target. Rows between the same two
+//! `*N` pseudo-node with an edge to its target (an `except` row's node
+//! says `except A, B` under its name), and a row of a state set `A | B` is
+//! an edge from each of its states. Rows between the same two
 //! nodes (several self-loops on one state, say) are **one edge** whose
 //! label lists them, one line per row (`EN: condition`, its jobs in a
 //! smaller line under it), and a loop of several rows hangs below its
@@ -158,22 +160,40 @@ fn edge_attrs(edge: &Edge, all: &[Edge]) -> String {
     attrs
 }
 
-/// The node a row leaves from: its state, or its own `*N` pseudo-node.
-pub(crate) fn from_node(p: &Printer, r: &Row) -> String {
-    match r.from {
-        From::DontCare(_) => format!("*{}", r.position),
-        From::State(s) => p.state(s),
+/// The nodes a row leaves from: its state, each state of its set (one
+/// edge per state, every one labelled with the row), or its own `*N`
+/// pseudo-node (an `except` row's says which states it leaves out).
+pub(crate) fn from_nodes(p: &Printer, r: &Row) -> Vec<String> {
+    match &r.from {
+        From::DontCare(_) | From::Except(..) => vec![format!("*{}", r.position)],
+        From::State(s) => vec![p.state(*s)],
+        From::States(set) => set.iter().map(|s| p.state(*s)).collect(),
     }
 }
 
-/// The node a row goes to (`same`: where it left from).
-pub(crate) fn to_node(p: &Printer, r: &Row) -> String {
+/// The node a row goes to when it leaves from node `from` (`same`: there).
+pub(crate) fn to_node(p: &Printer, r: &Row, from: &str) -> String {
     match r.to {
-        Target::Same => from_node(p, r),
+        Target::Same => from.to_string(),
         Target::State(_) => p.target(r),
         Target::Done => "Done".to_string(),
         Target::Error(_) => "Error".to_string(),
     }
+}
+
+/// The attributes of the `*N` node of an `except` row: dashed, labelled
+/// `*N` over `except A, B`.
+fn except_node_attrs(p: &Printer, r: &Row) -> Option<String> {
+    let From::Except(_, out) = &r.from else {
+        return None;
+    };
+    let names: Vec<String> = out.iter().map(|s| p.state(*s)).collect();
+    let label = format!(
+        "*{}<BR/><FONT POINT-SIZE=\"8\">except {}</FONT>",
+        r.position,
+        html(&names.join(", "))
+    );
+    Some(format!("label=<{label}>, style=dashed"))
 }
 
 /// A row's line: `E2: condition` (`→ Error(E)` added when it names one).
@@ -262,9 +282,12 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
 
     // Nodes in order of first appearance in the rows.
     let mut emitted: Vec<String> = Vec::new();
-    let mut node = |out: &mut String, id: String| {
+    let mut node = |out: &mut String, id: String, r: &Row| {
         if !emitted.contains(&id) {
-            let attrs = node_attrs(&id);
+            let attrs = match except_node_attrs(&p, r).filter(|_| id.starts_with('*')) {
+                Some(a) => a,
+                None => node_attrs(&id),
+            };
             let sep = if attrs.is_empty() { "" } else { ", " };
             let _ = writeln!(
                 out,
@@ -288,20 +311,23 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
                 quoted(&tooltip(ir, r))
             );
             if !matches!(r.to, Target::Same) {
-                node(&mut out, to_node(&p, r));
+                node(&mut out, to_node(&p, r, ""), r);
                 let _ = writeln!(
                     out,
                     "    {} -> {} [id={}, style=dashed];",
                     quoted(&note),
-                    quoted(&to_node(&p, r)),
+                    quoted(&to_node(&p, r, "")),
                     quoted(&edge_id(&[r.display_name()]))
                 );
             }
             continue;
         }
-        node(&mut out, from_node(&p, r));
-        node(&mut out, to_node(&p, r));
-        edges.push((from_node(&p, r), to_node(&p, r), row_line(ir, &p, r)));
+        for from in from_nodes(&p, r) {
+            let to = to_node(&p, r, &from);
+            node(&mut out, from.clone(), r);
+            node(&mut out, to.clone(), r);
+            edges.push((from, to, row_line(ir, &p, r)));
+        }
     }
     let edges = merge_edges(edges);
     for e in &edges {

@@ -6,7 +6,7 @@
 //! function returning a string.
 
 use crate::GENERATED;
-use rcs_dsl::ir::{Controller, Ir, Row, Target};
+use rcs_dsl::ir::{Controller, From, Ir, Row, Target};
 use rcs_dsl::pretty::Printer;
 use std::fmt::Write;
 
@@ -24,9 +24,12 @@ fn code(s: &str) -> String {
 /// site's).
 pub fn next_and_jobs(p: &Printer, r: &Row) -> (String, Vec<String>) {
     let next = match r.to {
-        // A don't-care row (or `otherwise`) that stays stays wherever it fired.
-        Target::Same if r.is_dont_care() => "same".to_string(),
-        Target::Same => format!("{} (same)", p.from(r)),
+        // A row of one state that stays, stays there; any other row
+        // (`*`, a set, `except`, `otherwise`) wherever it fired.
+        Target::Same => match r.from {
+            From::State(_) => format!("{} (same)", p.from(r)),
+            _ => "same".to_string(),
+        },
         _ => p.target(r),
     };
     (next, r.jobs.iter().map(|j| p.job(j)).collect())
@@ -107,10 +110,11 @@ pub fn controller_tables(ir: &Ir, ctrl: &Controller) -> String {
         out.push_str("|---|---|---|---|---|");
         out.push_str(if notes { "---|\n" } else { "\n" });
         for r in &plan.rows {
+            // A set's `|` escaped, so that it stays in its cell.
             let from = if r.is_otherwise() {
                 "any".to_string()
             } else {
-                p.from(r)
+                cell(&p.from(r))
             };
             let (next, jobs) = next_and_jobs(&p, r);
             let mut row = if r.is_otherwise() {

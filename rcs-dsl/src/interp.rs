@@ -280,11 +280,7 @@ impl<'ir> Interpreter<'ir> {
         let mut chosen = None;
         self.condition_calls = Some(Vec::new());
         for r in plan.rows.iter().filter(|r| !r.is_otherwise()) {
-            let from_ok = match r.from {
-                From::DontCare(_) => true,
-                From::State(s) => s == state,
-            };
-            if !from_ok {
+            if !r.applies_in(state) {
                 continue;
             }
             if let Condition::When(c) = &r.cond {

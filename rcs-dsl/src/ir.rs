@@ -453,8 +453,24 @@ impl Row {
         matches!(self.cond, Condition::Otherwise)
     }
 
+    /// Written with `*` (`*N`, or `*N except A | B`): the row has its own
+    /// dashed `*N` node in graphs, answers to `*N` in scenarios, and is
+    /// tried in every state's arm of the generated code. An `except` row
+    /// is one, but it does not apply in the states it leaves out: ask
+    /// [`Row::applies_in`] whether a row applies in a state.
     pub fn is_dont_care(&self) -> bool {
-        matches!(self.from, From::DontCare(_))
+        matches!(self.from, From::DontCare(_) | From::Except(..))
+    }
+
+    /// Whether the row's `from` covers `state` (its condition aside).
+    pub fn applies_in(&self, state: StateId) -> bool {
+        self.from.applies_in(state)
+    }
+
+    /// The states of `plan` the row's `from` covers (see
+    /// [`From::states_covered`]).
+    pub fn states_covered<'p>(&'p self, plan: &Plan) -> impl Iterator<Item = StateId> + 'p {
+        self.from.states_covered(plan.states.len())
     }
 
     /// The row's name everywhere — tables, graphs, diagnostics, coverage,
@@ -470,6 +486,62 @@ pub enum From {
     /// `*` / `*N` (with N as written, if any), or an `otherwise` without `*`.
     DontCare(Option<u32>),
     State(StateId),
+    /// `A | B | C` (LANGUAGE.md §8): the row applies in each, in the order
+    /// written. Empty for a shared row none of whose states belongs to the
+    /// plan: it never applies.
+    States(Vec<StateId>),
+    /// `*N except A | B`: every state but those (N as written, if any).
+    Except(Option<u32>, Vec<StateId>),
+}
+
+impl From {
+    /// Whether the pattern covers `state`.
+    pub fn applies_in(&self, state: StateId) -> bool {
+        match self {
+            From::DontCare(_) => true,
+            From::State(s) => *s == state,
+            From::States(set) => set.contains(&state),
+            From::Except(_, out) => !out.contains(&state),
+        }
+    }
+
+    /// The states, of a plan with `states` states, the pattern covers: a
+    /// state or a set's in the order written (without walking the plan's
+    /// other states), `*` and `except` in state order.
+    pub fn states_covered(&self, states: usize) -> impl Iterator<Item = StateId> + '_ {
+        let (listed, all_but): (&[StateId], Option<&[StateId]>) = match self {
+            From::State(s) => (std::slice::from_ref(s), None),
+            From::States(set) => (set, None),
+            From::DontCare(_) => (&[], Some(&[])),
+            From::Except(_, out) => (&[], Some(out)),
+        };
+        let rest = all_but.into_iter().flat_map(move |out| {
+            (0..states as u32)
+                .map(StateId)
+                .filter(move |s| !out.contains(s))
+        });
+        listed.iter().copied().chain(rest)
+    }
+
+    /// Whether the pattern names `state` itself (`S1`, or `S1` in a set):
+    /// the rows a state's own list shows; a `*` row names none.
+    pub fn names(&self, state: StateId) -> bool {
+        match self {
+            From::State(s) => *s == state,
+            From::States(set) => set.contains(&state),
+            From::DontCare(_) | From::Except(..) => false,
+        }
+    }
+
+    /// The state a row is judged in when one state must stand for all it
+    /// covers: `S0` if covered (a new command may arrive only there, so
+    /// it assumes least), else the first covered, else `None`.
+    pub fn representative(&self, states: usize) -> Option<StateId> {
+        if self.applies_in(StateId::S0) {
+            return Some(StateId::S0);
+        }
+        self.states_covered(states).next()
+    }
 }
 
 #[derive(Clone, Debug, Serialize)]

@@ -228,12 +228,20 @@ impl<'a> Printer<'a> {
         }
     }
 
-    /// `*N`, `*` or a state name.
+    /// `*N`, a state name, a set `A | B`, or `*N except A | B`.
     pub fn from(&self, r: &Row) -> String {
-        match r.from {
+        match &r.from {
             From::DontCare(_) => format!("*{}", r.position),
-            From::State(s) => self.state(s),
+            From::State(s) => self.state(*s),
+            From::States(set) => self.states(set),
+            From::Except(_, out) => format!("*{} except {}", r.position, self.states(out)),
         }
+    }
+
+    /// States as a set is written: `A | B | C`.
+    pub fn states(&self, set: &[StateId]) -> String {
+        let names: Vec<String> = set.iter().map(|s| self.state(*s)).collect();
+        names.join(" | ")
     }
 
     pub fn state(&self, s: StateId) -> String {

@@ -377,7 +377,17 @@ controller P {
             prop::collection::vec((condition(), target(), jobs()), 1..=2),
             prop::collection::vec(
                 (
-                    prop::sample::select(vec!["*", "S0", "S1", "S1", "S2", "S2", "S3"]),
+                    prop::sample::select(vec![
+                        "*",
+                        "S0",
+                        "S1",
+                        "S1",
+                        "S2",
+                        "S2",
+                        "S3",
+                        "S1 | S2",
+                        "* except S1",
+                    ]),
                     condition(),
                     target(),
                     jobs(),

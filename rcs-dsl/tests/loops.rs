@@ -252,8 +252,9 @@ fn command_storms_send_on_consecutive_cycles_on_the_interpreter() {
     assert!(found >= 3, "only {found} command storms replayed");
 }
 
-/// A random row: from a state or `*`, a condition over the inputs, the
-/// counters, the parameter and the subordinate, a target, maybe a send.
+/// A random row: from a state, a state set, `*` or `* except …`, a
+/// condition over the inputs, the counters, the parameter and the
+/// subordinate, a target, maybe a send.
 fn row() -> impl Strategy<Value = String> {
     let atom = prop::sample::select(vec![
         "s.a",
@@ -275,7 +276,20 @@ fn row() -> impl Strategy<Value = String> {
         "X.status == NOT_READY",
         "X.error",
     ]);
-    let from = prop::sample::select(vec!["S1", "S2", "S3", "*"]);
+    let from = prop::sample::select(vec![
+        "S1",
+        "S2",
+        "S3",
+        "*",
+        "S1",
+        "S2",
+        "S3",
+        "*",
+        "S1 | S2",
+        "S2 | S3",
+        "* except S1",
+        "* except S2 | S3",
+    ]);
     // Mostly to states, for rings to form.
     let to = prop::sample::select(vec!["S1", "S2", "S3", "S1", "S2", "S3", "same", "Done"]);
     (

@@ -77,20 +77,23 @@ pub fn diff_dot(plan: &PlanDiff, source: &str) -> String {
         if v.otherwise {
             // Not an edge of any state: a note, with an arrow when it
             // leaves the state (as in `crate::dot`).
-            let to = (v.target != "same").then(|| v.to_node());
+            let to = (v.target != "same").then(|| v.to_node(""));
             if let Some(t) = to.as_ref().filter(|t| !nodes.contains(t)) {
                 nodes.push(t.clone());
             }
             notes.push((format!("{} otherwise", v.label), line, to));
             continue;
         }
-        let (from, to) = (v.from_node(), v.to_node());
-        for n in [&from, &to] {
-            if !nodes.contains(n) {
-                nodes.push(n.clone());
+        // A set is one edge per state, each with the row's line.
+        for from in v.from_nodes() {
+            let to = v.to_node(&from);
+            for n in [&from, &to] {
+                if !nodes.contains(n) {
+                    nodes.push(n.clone());
+                }
             }
+            edges.push((from, to, line.clone()));
         }
-        edges.push((from, to, line));
     }
     for n in &nodes {
         let mut attrs = node_attrs(n);

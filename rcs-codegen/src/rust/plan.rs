@@ -213,13 +213,21 @@ pub(super) fn plan_fn(
         .copied()
         .filter(|r| r.is_dont_care())
         .collect();
-    // States with rows of their own get an arm; every other state (S0 too,
-    // unless it has rows) shares the don't-care arm.
+    // States with rows of their own (alone or in a set), and the states an
+    // `except` leaves out, get an arm; every other state (S0 too, unless it
+    // has one) shares the don't-care arm, where each `*` and `except` row
+    // applies. An arm holds the rows that apply in its state, in position
+    // order, so the first match is the interpreter's.
     let mut arm_states: Vec<StateId> = Vec::new();
     for r in &ordinary {
-        if let From::State(s) = r.from {
-            if !arm_states.contains(&s) {
-                arm_states.push(s);
+        let named = match &r.from {
+            From::DontCare(_) => &[][..],
+            From::State(s) => std::slice::from_ref(s),
+            From::States(set) | From::Except(_, set) => set,
+        };
+        for s in named {
+            if !arm_states.contains(s) {
+                arm_states.push(*s);
             }
         }
     }
@@ -232,10 +240,12 @@ pub(super) fn plan_fn(
                 .copied()
                 .filter(|r| match r.from {
                     From::State(x) => x == *s,
-                    From::DontCare(_) => {
+                    // Outside S0 a row whose condition starts with
+                    // `new_command` cannot match and calls no hook: left out.
+                    _ => {
                         let entry_only =
                             matches!(&r.cond, Condition::When(e) if starts_with_new_command(e));
-                        *s == StateId::S0 || !entry_only
+                        r.applies_in(*s) && (*s == StateId::S0 || !entry_only)
                     }
                 })
                 .collect();

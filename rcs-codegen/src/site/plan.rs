@@ -8,7 +8,7 @@ use super::html::{docs, esc, finding, page};
 use super::index::graph_or_notice;
 use super::{ctrl_page, root_of, SetDoc, Site};
 use crate::table::next_and_jobs;
-use rcs_dsl::ir::{Controller, Plan, Target};
+use rcs_dsl::ir::{Controller, From, Plan, StateId, Target};
 use rcs_dsl::pretty::Printer;
 use rcs_dsl::source::Span;
 use rcs_dsl::Diagnostic;
@@ -189,7 +189,7 @@ fn states(
         let from: Vec<String> = plan
             .rows
             .iter()
-            .filter(|r| p.from(r) == *name)
+            .filter(|r| r.from.names(StateId(i as u32)))
             .map(|r| {
                 format!(
                     "<a href=\"#row-{}\">{}</a>",
@@ -241,10 +241,12 @@ fn rows(
             Target::Error(_) => jobs.push("status ERROR".into()),
             _ => {}
         }
-        let current = if r.is_dont_care() {
-            esc(&p.from(r))
-        } else {
-            format!("<a href=\"#state-{0}\">{0}</a>", esc(&p.from(r)))
+        // Each state named links to its entry in the list of states.
+        let link = |s: &StateId| format!("<a href=\"#state-{0}\">{0}</a>", esc(&p.state(*s)));
+        let current = match &r.from {
+            From::State(s) => link(s),
+            From::States(set) => set.iter().map(link).collect::<Vec<_>>().join(" | "),
+            From::DontCare(_) | From::Except(..) => esc(&p.from(r)),
         };
         let graph = match edges.get(&name) {
             Some(e) => format!(" <a class=\"to-graph\" href=\"#{}\">graph</a>", esc(e)),

@@ -232,7 +232,9 @@ impl PlanAnalysis<'_> {
         let params = self.command_leaves();
         // Only a row that compares a parameter exactly can be made false
         // by the values its state is entered with (for a proof, an opaque
-        // atom is a free boolean whatever the parameter).
+        // atom is a free boolean whatever the parameter). Only a row of one
+        // state is judged: a set or `except` row would have to be false in
+        // each of its states, and leaving it out claims nothing.
         let candidates = self.plan.rows.iter().enumerate().any(|(i, row)| {
             matches!(row.from, From::State(s) if s != StateId::S0) && !self.free_of(i, &params)
         });

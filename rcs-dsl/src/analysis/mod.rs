@@ -434,10 +434,12 @@ impl<'ir> PlanAnalysis<'ir> {
         };
         match q {
             Question::Matches(row) => {
-                let state = match self.plan.rows[row].from {
-                    From::State(s) => s,
-                    From::DontCare(_) => StateId::S0,
-                };
+                // A row covering no state never matches: judge it in S0,
+                // where its condition alone decides (the graph skips it).
+                let state = self.plan.rows[row]
+                    .from
+                    .representative(self.plan.states.len())
+                    .unwrap_or(StateId::S0);
                 (cond(row), state)
             }
             Question::FiresIn(row, state) => {
@@ -661,8 +663,5 @@ fn assigned_vars(ctrl: &Controller) -> Vec<crate::ir::VarId> {
 
 /// Whether a row's state pattern covers `state`.
 pub fn covers(from: &From, state: StateId) -> bool {
-    match from {
-        From::DontCare(_) => true,
-        From::State(s) => *s == state,
-    }
+    from.applies_in(state)
 }

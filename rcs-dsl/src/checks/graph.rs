@@ -106,18 +106,17 @@ fn structural(p: &Plan) -> Analysis {
             Target::Done => done,
             Target::Error(_) => error,
         };
-        match row.from {
-            crate::ir::From::State(s) if s.index() != to => {
-                own_exit[s.index()] = true;
-                g.add_edge(NodeIndex::new(s.index()), NodeIndex::new(to), ());
+        if let crate::ir::From::DontCare(_) = row.from {
+            if !star_targets.contains(&to) {
+                star_targets.push(to);
+                g.add_edge(NodeIndex::new(any), NodeIndex::new(to), ());
             }
-            crate::ir::From::State(_) => {}
-            crate::ir::From::DontCare(_) => {
-                if !star_targets.contains(&to) {
-                    star_targets.push(to);
-                    g.add_edge(NodeIndex::new(any), NodeIndex::new(to), ());
-                }
-            }
+            continue;
+        }
+        // One state, a set, or `except`: an edge from each state covered.
+        for s in row.states_covered(p).filter(|s| s.index() != to) {
+            own_exit[s.index()] = true;
+            g.add_edge(NodeIndex::new(s.index()), NodeIndex::new(to), ());
         }
     }
     if !star_targets.is_empty() {

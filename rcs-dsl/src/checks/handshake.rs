@@ -12,8 +12,8 @@ use crate::analysis::{covers, PlanAnalysis};
 use crate::ast::BinOp;
 use crate::diagnostic::Diagnostic;
 use crate::ir::{
-    CommandId, Controller, CtrlId, Expr, ExprKind, From, Ir, Job, Plan, Row, StateId, StatusId,
-    SubProp, Target,
+    CommandId, Controller, CtrlId, Expr, ExprKind, Ir, Job, Plan, Row, StateId, StatusId, SubProp,
+    Target,
 };
 use crate::lint::Lint;
 
@@ -44,10 +44,7 @@ impl Summary {
                 plan.rows.iter().position(|r| {
                     matches!(r.to, Target::Error(_))
                         && !graph.never_matches[r.position as usize]
-                        && match r.from {
-                            From::State(s) => graph.reachable[s.index()],
-                            From::DontCare(_) => true,
-                        }
+                        && super::plan::from_reachable(r, graph)
                 })
             })
             .collect();

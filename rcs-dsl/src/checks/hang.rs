@@ -67,11 +67,7 @@ pub(crate) fn check_incomplete_states(
             format!("with `{values}`")
         };
         // The first row of the state, else where the state is first named.
-        let (span, label) = match p
-            .rows
-            .iter()
-            .find(|r| r.from == crate::ir::From::State(hang.state))
-        {
+        let (span, label) = match p.rows.iter().find(|r| r.from.names(hang.state)) {
             Some(r) => (
                 r.span,
                 format!("no row of `{name}` can fire again with these values"),

@@ -52,7 +52,7 @@ pub(crate) fn check_row_numbers(c: &Controller, p: &Plan, sink: &mut Sink) {
                 );
             }
         }
-        if let From::DontCare(Some(n)) = r.from {
+        if let From::DontCare(Some(n)) | From::Except(Some(n), _) = r.from {
             if n != r.position {
                 sink.error(
                     Diagnostic::error(
@@ -132,9 +132,9 @@ pub(crate) fn check_entry(p: &Plan, sink: &mut Sink) {
         if r.is_otherwise() {
             continue;
         }
-        // An entry row from a state other than S0 never matches: it is
+        // An entry row that does not apply in S0 never matches: it is
         // `unreachable_row`'s (or `unreachable_state`'s) finding, not this one's.
-        if r.is_entry && matches!(r.from, From::State(s) if s != StateId::S0) {
+        if r.is_entry && !r.applies_in(StateId::S0) {
             continue;
         }
         if !r.is_entry {
@@ -165,10 +165,14 @@ fn has_false_conjunct(e: &Expr) -> bool {
     }
 }
 
-fn from_reachable(r: &Row, a: &Analysis) -> bool {
-    match r.from {
-        From::State(s) => a.reachable[s.index()],
+/// Whether a row applies in some reachable state. A `*` row always does
+/// (S0 is reachable); a set or `except` row when one of its states is.
+pub(crate) fn from_reachable(r: &Row, a: &Analysis) -> bool {
+    match &r.from {
         From::DontCare(_) => true,
+        from => from
+            .states_covered(a.reachable.len())
+            .any(|s| a.reachable[s.index()]),
     }
 }
 
@@ -180,7 +184,7 @@ pub(crate) fn check_unreachable_rows(p: &Plan, a: &Analysis, sink: &mut Sink) {
         let Condition::When(c) = &r.cond else {
             continue;
         };
-        let d = if r.is_entry && matches!(r.from, From::State(s) if s != StateId::S0) {
+        let d = if r.is_entry && !r.applies_in(StateId::S0) {
             Diagnostic::error(
                 Code::UnreachableRow,
                 format!(

@@ -103,7 +103,7 @@ fn effect(
         }
         match an.can_fire_while(nb, na, s) {
             Answer::Never => {}
-            Answer::Can(w) if a_kept && (a_old.from == "*" || a_old.from == state.name) => {
+            Answer::Can(w) if a_kept && a_old.covers_name(&state.name) => {
                 return Some(Effect::ChangesFiring {
                     state: state.name.clone(),
                     input: w.text(),

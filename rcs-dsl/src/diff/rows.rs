@@ -34,7 +34,8 @@ pub struct RowView {
     /// `E3` (the `otherwise` row too).
     pub label: String,
     pub position: u32,
-    /// The state pattern: a state's name, or `*` for a don't-care row.
+    /// The state pattern: a state's name, `*` for a don't-care row, a set
+    /// `A | B`, or `* except A | B`.
     pub from: String,
     /// The condition (`otherwise` for the otherwise row).
     pub condition: String,
@@ -55,9 +56,11 @@ impl RowView {
         RowView {
             label: r.display_name(),
             position: r.position,
-            from: match r.from {
+            from: match &r.from {
                 From::DontCare(_) => "*".to_string(),
-                From::State(s) => p.state(s),
+                From::State(s) => p.state(*s),
+                From::States(set) => p.states(set),
+                From::Except(_, out) => format!("* except {}", p.states(out)),
             },
             condition: p.condition(r),
             target: p.target(r),
@@ -69,19 +72,45 @@ impl RowView {
         }
     }
 
-    /// The graph node the row leaves from: its state, or `*N`.
-    pub fn from_node(&self) -> String {
-        if self.from == "*" {
-            format!("*{}", self.position)
+    /// Whether the row's pattern is written with `*` (`*`, `* except …`).
+    fn starred(&self) -> bool {
+        self.from.starts_with('*')
+    }
+
+    /// The graph nodes the row leaves from: its state, each state of its
+    /// set, or its own `*N` (an `except` row too).
+    pub fn from_nodes(&self) -> Vec<String> {
+        if self.starred() {
+            vec![format!("*{}", self.position)]
         } else {
-            self.from.clone()
+            self.from.split(" | ").map(str::to_string).collect()
         }
     }
 
-    /// The graph node the row goes to.
-    pub fn to_node(&self) -> String {
+    /// The state pattern by meaning: a set's or an `except` list's states
+    /// in name order, so that `B | A` is no change from `A | B`.
+    pub fn pattern(&self) -> String {
+        let (head, list) = match self.from.strip_prefix("* except ") {
+            Some(out) => ("* except ", out),
+            None => ("", self.from.as_str()),
+        };
+        let mut names: Vec<&str> = list.split(" | ").collect();
+        names.sort_unstable();
+        format!("{head}{}", names.join(" | "))
+    }
+
+    /// Whether the row applies in the state named `state`.
+    pub fn covers_name(&self, state: &str) -> bool {
+        match self.from.strip_prefix("* except ") {
+            Some(out) => !out.split(" | ").any(|s| s == state),
+            None => self.from == "*" || self.from.split(" | ").any(|s| s == state),
+        }
+    }
+
+    /// The graph node the row goes to when it leaves from node `from`.
+    pub fn to_node(&self, from: &str) -> String {
         match self.target.as_str() {
-            "same" => self.from_node(),
+            "same" => from.to_string(),
             t if t.starts_with("Error") => "Error".to_string(),
             t => t.to_string(),
         }
@@ -176,8 +205,15 @@ pub(crate) fn match_rows(old: &[RowView], new: &[RowView]) -> Vec<(usize, usize)
         |v| format!("{}\u{0}{}", v.label, v.content()),
         |v| v.content(),
         |v| v.label.clone(),
-        |v| format!("{}\u{0}{}", v.from, v.condition),
-        |v| format!("{}\u{0}{}\u{0}{}", v.from, v.target, v.jobs.join("\u{0}")),
+        |v| format!("{}\u{0}{}", v.pattern(), v.condition),
+        |v| {
+            format!(
+                "{}\u{0}{}\u{0}{}",
+                v.pattern(),
+                v.target,
+                v.jobs.join("\u{0}")
+            )
+        },
     ];
     let mut old_of: Vec<Option<usize>> = vec![None; new.len()];
     let mut new_of: Vec<Option<usize>> = vec![None; old.len()];
@@ -205,7 +241,7 @@ pub(crate) fn match_rows(old: &[RowView], new: &[RowView]) -> Vec<(usize, usize)
 
 fn change(o: &RowView, n: &RowView) -> RowChange {
     let mut parts = Vec::new();
-    if o.from != n.from {
+    if o.pattern() != n.pattern() {
         parts.push("from");
     }
     if o.condition != n.condition {

@@ -15,6 +15,7 @@ mod headers;
 mod index;
 mod plans;
 mod schedule;
+mod state_sets;
 mod types;
 mod verbs;
 pub use expr::type_name;

@@ -3,6 +3,7 @@
 //! expression checker of `lower::expr`.
 
 use super::expr::{Cx, Subscript, Value};
+use super::state_sets::{from_names, intern, is_terminal, row_number};
 use super::*;
 use crate::ast::{self, AssignOp, BinOp};
 use crate::diagnostic::{Code, Diagnostic};
@@ -23,6 +24,23 @@ impl Cx<'_, '_> {
         }];
         let mut names = ByName::default();
         names.first_or_insert("S0", 0);
+        // The plan's states first, in order of first mention: the `from`s
+        // of its own rows and every target. A state named only in the
+        // `from` of shared rows (`use NAME`) is not one of them (§8).
+        for r in &ast_rows {
+            if r.shared.is_none() {
+                for n in from_names(&r.from) {
+                    if !is_terminal(n) {
+                        intern(&mut states, &mut names, n);
+                    }
+                }
+            }
+            if let ast::Target::State(n) = &r.target {
+                if n.text != "Done" {
+                    intern(&mut states, &mut names, n);
+                }
+            }
+        }
         let mut rows = Vec::with_capacity(ast_rows.len());
         for (pos, r) in ast_rows.iter().enumerate() {
             if let Some(row) = self.row(r, pos as u32, (&mut states, &mut names)) {
@@ -51,53 +69,30 @@ impl Cx<'_, '_> {
         position: u32,
         (states, names): (&mut Vec<State>, &mut ByName),
     ) -> Option<Row> {
-        let mut intern = |states: &mut Vec<State>, n: &ast::Name| -> StateId {
-            match names.first_or_insert(&n.text, states.len()) {
-                Some(i) => {
-                    if states[i].span.is_none() {
-                        states[i].span = Some(n.span);
-                    }
-                    StateId(i as u32)
-                }
-                None => {
-                    states.push(State {
-                        name: n.text.to_string(),
-                        span: Some(n.span),
-                    });
-                    StateId(states.len() as u32 - 1)
-                }
-            }
-        };
         let (from, from_span) = match &r.from {
-            ast::From::DontCare(n, s) => {
-                (From::DontCare(n.map(|n| n.min(u32::MAX as u64) as u32)), *s)
-            }
+            ast::From::DontCare(n, s) => (From::DontCare(n.map(row_number)), *s),
             ast::From::Implicit => (From::DontCare(None), r.cond_span),
-            ast::From::State(n) if n.text == "Done" || n.text == "Error" => {
-                self.diags.push(
-                    Diagnostic::error(
-                        Code::UnreachableRow,
-                        format!("a row cannot start in `{}`", n.text),
-                        n.span,
-                        "terminal state",
-                    )
-                    .with_help(format!(
-                        "after `{}` the plan runs no rows until a new command arrives",
-                        n.text
-                    )),
-                );
+            ast::From::State(n) if is_terminal(n) => {
+                self.terminal_from(n);
                 (From::DontCare(None), n.span)
             }
-            ast::From::State(n) => (From::State(intern(states, n)), n.span),
-            // Lowered by the state-set change (LANGUAGE.md §8); until then refused.
-            ast::From::States(_, s) | ast::From::Except(_, _, s) => {
-                self.diags.push(Diagnostic::error(
-                    Code::Syntax,
-                    "state sets are not lowered yet",
-                    *s,
-                    "here",
-                ));
-                (From::DontCare(None), *s)
+            ast::From::State(n) if r.shared.is_some() => {
+                let set = self.state_set(std::slice::from_ref(n), r, (states, names));
+                match set.as_slice() {
+                    [s] => (From::State(*s), n.span),
+                    _ => (From::States(set), n.span),
+                }
+            }
+            ast::From::State(n) => (From::State(intern(states, names, n)), n.span),
+            ast::From::States(list, s) => {
+                (From::States(self.state_set(list, r, (states, names))), *s)
+            }
+            ast::From::Except(n, list, s) => {
+                let out = self.state_set(list, r, (states, names));
+                if out.len() == states.len() {
+                    self.except_everything(list, *s, states.len());
+                }
+                (From::Except(n.map(row_number), out), *s)
             }
         };
         let (cond, is_entry) = match &r.cond {
@@ -113,7 +108,7 @@ impl Cx<'_, '_> {
             ast::Target::Error(None, _) => Target::Error(None),
             ast::Target::Error(Some(code), _) => Target::Error(self.error_code(code)),
             ast::Target::State(n) if n.text == "Done" => Target::Done,
-            ast::Target::State(n) => Target::State(intern(states, n)),
+            ast::Target::State(n) => Target::State(intern(states, names, n)),
         };
         // Sized once: `filter_map` gives no lower bound, and a vector grown
         // from empty holds four jobs (700 bytes) for the usual one or two.
@@ -121,7 +116,7 @@ impl Cx<'_, '_> {
         jobs.extend(r.jobs.iter().filter_map(|j| self.job(j)));
         Some(Row {
             position,
-            label: r.label.map(|(n, _)| n.min(u32::MAX as u64) as u32),
+            label: r.label.map(|(n, _)| row_number(n)),
             docs: r.docs.clone(),
             from,
             cond,

@@ -23,7 +23,7 @@ impl Builder {
                     let n = c.as_str()[1..].parse::<u64>().unwrap_or(u64::MAX);
                     label = Some((n, s));
                 }
-                Rule::from_state => from = Some(self.row_from(c)),
+                Rule::from_state => from = Some(self.state_pattern(c)),
                 Rule::kw_otherwise => {
                     cond_span = self.span(&c);
                     otherwise = Some(cond_span);
@@ -89,7 +89,7 @@ impl Builder {
     }
 
     /// `*N`, `*N except A | B`, `A`, or `A | B | C`.
-    fn row_from(&mut self, p: Pair<Rule>) -> From {
+    fn state_pattern(&mut self, p: Pair<Rule>) -> From {
         let whole = self.span(&p);
         let mut inner = p.into_inner();
         let first = inner.next().expect("from has a first part");

@@ -67,10 +67,33 @@ pub fn float_literal(v: f64, ty: &Type) -> f64 {
     }
 }
 
+/// `x & y`, `x | y`, `x ^ y`, `x << y`, `x >> y` for `x` (and, but for
+/// shifts, `y`) of type `t`. A shift by the type's width or more, or by a
+/// negative amount, gives 0, never a panic (the generated code's
+/// `checked_shl(..).unwrap_or(0)`); `>>` of a signed value is arithmetic.
+pub fn bitwise(op: BinOp, x: i128, y: i128, t: IntTy) -> i128 {
+    let bits = match t {
+        IntTy::I8 | IntTy::U8 => 8,
+        IntTy::I16 | IntTy::U16 => 16,
+        IntTy::I32 | IntTy::U32 => 32,
+        IntTy::I64 | IntTy::U64 => 64,
+    };
+    match op {
+        BinOp::BitAnd => wrap(x & y, t),
+        BinOp::BitOr => wrap(x | y, t),
+        BinOp::BitXor => wrap(x ^ y, t),
+        BinOp::Shl if (0..bits).contains(&y) => wrap(((x as u128) << y) as i128, t),
+        BinOp::Shr if (0..bits).contains(&y) => wrap(x >> y, t),
+        _ => 0,
+    }
+}
+
 /// `!x` or `-x`, the result of type `ty`.
 pub fn unary(op: UnOp, v: Value, ty: &Type) -> Value {
     match (op, v, ty) {
         (UnOp::Not, Value::Bool(b), _) => Value::Bool(!b),
+        // Bitwise not, in the value's type.
+        (UnOp::Not, Value::Int(i), Type::Int(t)) => Value::Int(wrap(!i, *t)),
         (UnOp::Neg, Value::Int(i), Type::Int(t)) => Value::Int(wrap(i.wrapping_neg(), *t)),
         (UnOp::Neg, Value::Float(f), _) => Value::Float(-f),
         (_, v, _) => v,
@@ -110,6 +133,12 @@ pub fn binary(op: BinOp, a: Value, b: Value, ty: &Type) -> Value {
         }
         BinOp::And => Value::Bool(truthy(&a) && truthy(&b)),
         BinOp::Or => Value::Bool(truthy(&a) || truthy(&b)),
+        BinOp::BitAnd | BinOp::BitOr | BinOp::BitXor | BinOp::Shl | BinOp::Shr => {
+            match (a, b, ty) {
+                (Value::Int(x), Value::Int(y), Type::Int(t)) => Value::Int(bitwise(op, x, y, *t)),
+                (a, _, _) => a,
+            }
+        }
         _ => match (a, b, ty) {
             (Value::Int(x), Value::Int(y), Type::Int(t)) => Value::Int(wrap(
                 match op {

@@ -12,9 +12,9 @@ pub struct Printer<'a> {
     pub plan: Option<&'a Plan>,
 }
 
-const UNARY: u8 = 6;
-const CAST: u8 = 7;
-const ATOM: u8 = 8;
+const UNARY: u8 = 10;
+const CAST: u8 = 11;
+const ATOM: u8 = 12;
 
 impl<'a> Printer<'a> {
     pub fn new(ir: &'a Ir, ctrl: &'a Controller, plan: Option<&'a Plan>) -> Self {
@@ -117,12 +117,24 @@ impl<'a> Printer<'a> {
             ExprKind::Binary(op, operands) => {
                 let [l, r] = &**operands;
                 let p = op.precedence();
+                // A bitwise operator beside a comparison is always
+                // parenthesised: the language requires it (C reads it the
+                // other way).
+                let min = |child: &Expr, base: u8| match &child.kind {
+                    ExprKind::Binary(inner, _)
+                        if (op.is_comparison() && inner.is_bitwise())
+                            || (op.is_bitwise() && inner.is_comparison()) =>
+                    {
+                        ATOM + 1
+                    }
+                    _ => base,
+                };
                 // Left-associative: the right operand needs parentheses at equal strength.
-                self.write(l, p, out);
+                self.write(l, min(l, p), out);
                 out.push(' ');
                 out.push_str(op.symbol());
                 out.push(' ');
-                self.write(r, p + 1, out);
+                self.write(r, min(r, p + 1), out);
             }
             ExprKind::Cast(x) => {
                 self.write(x, CAST, out);

@@ -114,3 +114,82 @@ fn nan_is_neither_below_nor_at_or_above() {
     assert_eq!(run(0, 1, 1.0, 0).1, "E2");
     assert_eq!(run(0, 1, f64::NAN, 0).1, "E3");
 }
+
+/// Bitwise operators and shifts (LANGUAGE.md §8), against Rust's own on
+/// the same types: `&`, `|`, `^`, `!` wrap to the type; a shift by the
+/// width or more, or by a negative amount, is 0; `>>` of a signed value is
+/// arithmetic.
+#[test]
+fn bitwise_and_shifts_follow_rust_and_never_panic() {
+    use rcs_dsl::arith::bitwise;
+    use rcs_dsl::ast::BinOp;
+    use rcs_dsl::ir::IntTy;
+    for x in [0u16, 1, 0x00FF, 0x8001, 0xFFFF] {
+        for y in [0u16, 3, 0x0F0F, 0xFFFF] {
+            let (xi, yi) = (i128::from(x), i128::from(y));
+            assert_eq!(
+                bitwise(BinOp::BitAnd, xi, yi, IntTy::U16),
+                i128::from(x & y)
+            );
+            assert_eq!(bitwise(BinOp::BitOr, xi, yi, IntTy::U16), i128::from(x | y));
+            assert_eq!(
+                bitwise(BinOp::BitXor, xi, yi, IntTy::U16),
+                i128::from(x ^ y)
+            );
+        }
+        for s in [-1i128, 0, 1, 7, 15, 16, 17, 200] {
+            let want_l = u32::try_from(s)
+                .ok()
+                .and_then(|s| x.checked_shl(s))
+                .unwrap_or(0);
+            let want_r = u32::try_from(s)
+                .ok()
+                .and_then(|s| x.checked_shr(s))
+                .unwrap_or(0);
+            assert_eq!(
+                bitwise(BinOp::Shl, i128::from(x), s, IntTy::U16),
+                i128::from(want_l),
+                "{x} << {s}"
+            );
+            assert_eq!(
+                bitwise(BinOp::Shr, i128::from(x), s, IntTy::U16),
+                i128::from(want_r),
+                "{x} >> {s}"
+            );
+        }
+    }
+    for x in [i8::MIN, -5, -1, 0, 1, 100, i8::MAX] {
+        for s in [-3i128, 0, 1, 6, 7, 8, 9] {
+            let want_l = u32::try_from(s)
+                .ok()
+                .and_then(|s| x.checked_shl(s))
+                .unwrap_or(0);
+            let want_r = u32::try_from(s)
+                .ok()
+                .and_then(|s| x.checked_shr(s))
+                .unwrap_or(0);
+            assert_eq!(
+                bitwise(BinOp::Shl, i128::from(x), s, IntTy::I8),
+                i128::from(want_l),
+                "{x} << {s}"
+            );
+            assert_eq!(
+                bitwise(BinOp::Shr, i128::from(x), s, IntTy::I8),
+                i128::from(want_r),
+                "{x} >> {s}"
+            );
+        }
+        let not = rcs_dsl::arith::unary(
+            rcs_dsl::ast::UnOp::Not,
+            Value::Int(i128::from(x)),
+            &rcs_dsl::ir::Type::Int(IntTy::I8),
+        );
+        assert_eq!(not, Value::Int(i128::from(!x)));
+    }
+    let not = rcs_dsl::arith::unary(
+        rcs_dsl::ast::UnOp::Not,
+        Value::Int(0x0F),
+        &rcs_dsl::ir::Type::Int(IntTy::U16),
+    );
+    assert_eq!(not, Value::Int(0xFFF0));
+}

@@ -15,11 +15,14 @@ use rcs_dsl::ir::*;
 const OR: u8 = 1;
 const AND: u8 = 2;
 const CMP: u8 = 3;
-const ADD: u8 = 5;
-const MUL: u8 = 6;
-const CAST: u8 = 7;
-const UNARY: u8 = 8;
-const ATOM: u8 = 9;
+const BIT_OR: u8 = 4;
+const BIT_XOR: u8 = 5;
+const BIT_AND: u8 = 6;
+const ADD: u8 = 8;
+const MUL: u8 = 9;
+const CAST: u8 = 10;
+const UNARY: u8 = 11;
+const ATOM: u8 = 12;
 
 /// Generated code with its strength, and whether it holds a block
 /// (a hoisted nested hook call), which cannot stand in an `if` condition.
@@ -427,10 +430,38 @@ impl Gen<'_> {
                 let m = method("checked_rem");
                 (quote!(#m.unwrap_or(0)), ATOM)
             }
+            // A shift by the width or more (or by a negative amount) is 0,
+            // as the interpreter's `arith::bitwise` says: never a panic.
+            BinOp::Shl | BinOp::Shr => {
+                let m = format_ident!(
+                    "{}",
+                    if op == BinOp::Shl {
+                        "checked_shl"
+                    } else {
+                        "checked_shr"
+                    }
+                );
+                let recv = a.at(ATOM);
+                let amount = &b.ts;
+                let ts = match r.ty {
+                    Type::Int(IntTy::U32) => quote!(#recv.#m(#amount).unwrap_or(0)),
+                    Type::Int(IntTy::U8 | IntTy::U16) => {
+                        quote!(#recv.#m(u32::from(#amount)).unwrap_or(0))
+                    }
+                    _ => quote!(match u32::try_from(#amount) {
+                        Ok(s) => #recv.#m(s).unwrap_or(0),
+                        Err(_) => 0,
+                    }),
+                };
+                (ts, ATOM)
+            }
             _ => {
                 let p = match op {
                     BinOp::Or => OR,
                     BinOp::And => AND,
+                    BinOp::BitOr => BIT_OR,
+                    BinOp::BitXor => BIT_XOR,
+                    BinOp::BitAnd => BIT_AND,
                     BinOp::Add | BinOp::Sub => ADD,
                     BinOp::Mul | BinOp::Div | BinOp::Rem => MUL,
                     _ => CMP,
@@ -544,7 +575,14 @@ impl Gen<'_> {
     /// `place = place OP rhs` with an arithmetic OP: the operator and `rhs`.
     fn self_update<'e>(&self, place: &Place, value: &'e Expr) -> Option<(BinOp, &'e Expr)> {
         let ExprKind::Binary(
-            op @ (BinOp::Add | BinOp::Sub | BinOp::Mul | BinOp::Div | BinOp::Rem),
+            op @ (BinOp::Add
+            | BinOp::Sub
+            | BinOp::Mul
+            | BinOp::Div
+            | BinOp::Rem
+            | BinOp::BitAnd
+            | BinOp::BitOr
+            | BinOp::BitXor),
             operands,
         ) = &value.kind
         else {
@@ -567,7 +605,13 @@ impl Gen<'_> {
                 let vt = &v.ts;
                 match (op, &place.ty) {
                     // `x = x / k` on floats reads better (and passes clippy) as `x /= k`.
-                    (AssignOp::Set, Type::Float(_)) if self.self_update(place, value).is_some() => {
+                    // So does `w = w | 0x80` on integers as `w |= 0x80`.
+                    (AssignOp::Set, Type::Float(_) | Type::Int(_))
+                        if self.self_update(place, value).is_some_and(|(op, _)| {
+                            place.ty != Type::Bool
+                                && (op.is_bitwise() || matches!(place.ty, Type::Float(_)))
+                        }) =>
+                    {
                         let (op, rhs) = self.self_update(place, value).expect("checked");
                         let rhs = self.expr(rhs).ts;
                         let op: TokenStream =

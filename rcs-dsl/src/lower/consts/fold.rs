@@ -364,7 +364,7 @@ impl Folder<'_, '_> {
         let arith_op = matches!(
             op,
             BinOp::Add | BinOp::Sub | BinOp::Mul | BinOp::Div | BinOp::Rem
-        );
+        ) || op.is_bitwise();
         let operand_hint = if logic {
             Some(&Type::Bool)
         } else if arith_op {
@@ -394,6 +394,17 @@ impl Folder<'_, '_> {
                         BinOp::Sub => x.wrapping_sub(y),
                         BinOp::Mul => x.wrapping_mul(y),
                         BinOp::Div => x.checked_div(y).unwrap_or(0),
+                        BinOp::BitAnd => x & y,
+                        BinOp::BitOr => x | y,
+                        BinOp::BitXor => x ^ y,
+                        BinOp::Shl => u32::try_from(y)
+                            .ok()
+                            .filter(|y| *y < 64)
+                            .map_or(0, |y| x << y),
+                        BinOp::Shr => u32::try_from(y)
+                            .ok()
+                            .filter(|y| *y < 64)
+                            .map_or(0, |y| x >> y),
                         _ => x.checked_rem(y).unwrap_or(0),
                     }),
                     ty: if matches!((a.ty, b.ty), (Ty::IntLit, Ty::IntLit)) {
@@ -411,15 +422,23 @@ impl Folder<'_, '_> {
         let (Ty::Known(ta), Ty::Known(tb)) = (&a.ty, &b.ty) else {
             return None;
         };
-        let fits = ta == tb
-            && match op {
-                BinOp::And | BinOp::Or => *ta == Type::Bool,
-                BinOp::Eq | BinOp::Ne => true,
-                BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge => {
-                    matches!(ta, Type::Int(_) | Type::Float(_))
-                }
-                _ => matches!(ta, Type::Int(_) | Type::Float(_)),
-            };
+        let int = |t: &Type| matches!(t, Type::Int(_));
+        let fits = match op {
+            // A shift's amount has a type of its own.
+            BinOp::Shl | BinOp::Shr => int(ta) && int(tb),
+            _ => {
+                ta == tb
+                    && match op {
+                        BinOp::And | BinOp::Or => *ta == Type::Bool,
+                        BinOp::BitAnd | BinOp::BitOr | BinOp::BitXor => int(ta),
+                        BinOp::Eq | BinOp::Ne => true,
+                        BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge => {
+                            matches!(ta, Type::Int(_) | Type::Float(_))
+                        }
+                        _ => matches!(ta, Type::Int(_) | Type::Float(_)),
+                    }
+            }
+        };
         if !fits {
             let (x, y) = (self.type_name(ta), self.type_name(tb));
             return self.mismatch(

@@ -160,6 +160,8 @@ impl Cx<'_, '_> {
         let literal = match &e.kind {
             ExprKind::Int(_) | ExprKind::Float(_) => true,
             ExprKind::Unary(UnOp::Neg, _) | ExprKind::Binary(..) => e.ty != *ty,
+            // `!0x0F` beside an integer: bitwise not, typed by its context.
+            ExprKind::Unary(UnOp::Not, _) => e.ty != *ty && matches!(e.ty, Type::Int(_)),
             _ => false,
         };
         if !literal {
@@ -194,18 +196,23 @@ impl Cx<'_, '_> {
                     format!("`f32` holds at most {:e} in magnitude", f32::MAX),
                 );
             }
-            (ExprKind::Unary(UnOp::Neg, inner), _) => self.fix_literals(inner, ty),
-            (ExprKind::Binary(op, operands), _) if is_arith(*op) => {
+            (ExprKind::Unary(UnOp::Neg | UnOp::Not, inner), _) => self.fix_literals(inner, ty),
+            (ExprKind::Binary(op, operands), _) if is_arith(*op) || is_bit_logic(*op) => {
                 let [l, r] = &mut **operands;
                 self.fix_literals(l, ty);
                 self.fix_literals(r, ty);
+            }
+            // A shift takes the type of its left side; its amount keeps its own.
+            (ExprKind::Binary(BinOp::Shl | BinOp::Shr, operands), _) => {
+                let [l, _] = &mut **operands;
+                self.fix_literals(l, ty);
             }
             _ => {}
         }
         if matches!(
             e.kind,
             ExprKind::Int(_) | ExprKind::Float(_) | ExprKind::Unary(..)
-        ) || matches!(&e.kind, ExprKind::Binary(op, ..) if is_arith(*op))
+        ) || matches!(&e.kind, ExprKind::Binary(op, ..) if is_arith(*op) || op.is_bitwise())
         {
             e.ty = ty.clone();
         }
@@ -391,6 +398,11 @@ pub(in crate::lower) fn known(t: &Ty) -> Option<Type> {
         Ty::Known(t) => Some(t.clone()),
         _ => None,
     }
+}
+
+/// `&`, `|`, `^`: both operands and the result of one integer type.
+pub(in crate::lower) fn is_bit_logic(op: BinOp) -> bool {
+    matches!(op, BinOp::BitAnd | BinOp::BitOr | BinOp::BitXor)
 }
 
 pub(in crate::lower) fn is_arith(op: BinOp) -> bool {

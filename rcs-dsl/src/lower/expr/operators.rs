@@ -18,13 +18,15 @@ impl Cx<'_, '_> {
         let ok = match (op, &t) {
             (_, Ty::Err) => return (err_expr(span), Ty::Err),
             (UnOp::Not, Ty::Known(Type::Bool)) => true,
+            // Bitwise not on integers, as in Rust (§8).
+            (UnOp::Not, Ty::IntLit | Ty::Known(Type::Int(_))) => true,
             (UnOp::Neg, Ty::IntLit | Ty::FloatLit | Ty::Known(Type::Float(_))) => true,
             (UnOp::Neg, Ty::Known(Type::Int(it))) => it.signed(),
             _ => false,
         };
         if !ok {
             let (sym, want) = if op == UnOp::Not {
-                ("!", "`bool`")
+                ("!", "`bool` or an integer")
             } else {
                 ("-", "a signed number")
             };
@@ -86,6 +88,7 @@ impl Cx<'_, '_> {
         span: Span,
     ) -> (Expr, Ty) {
         match op {
+            BinOp::Shl | BinOp::Shr => self.shift(op, l, r, span),
             BinOp::And | BinOp::Or => {
                 let a = self.check(l, &Type::Bool);
                 let b = self.check(r, &Type::Bool);
@@ -151,6 +154,7 @@ impl Cx<'_, '_> {
                     BinOp::Eq | BinOp::Ne => {
                         !matches!(t, Ty::Known(Type::Buffer(_) | Type::Array(..) | Type::Unit))
                     }
+                    _ if is_bit_logic(op) => matches!(t, Ty::IntLit | Ty::Known(Type::Int(_))),
                     _ => matches!(
                         t,
                         Ty::IntLit | Ty::FloatLit | Ty::Known(Type::Int(_) | Type::Float(_))
@@ -161,6 +165,7 @@ impl Cx<'_, '_> {
                     let what = match op {
                         BinOp::Eq | BinOp::Ne => "compared",
                         BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge => "ordered",
+                        _ if is_bit_logic(op) => "combined bit by bit (integers only)",
                         _ => "used in arithmetic",
                     };
                     self.mismatch(
@@ -170,7 +175,7 @@ impl Cx<'_, '_> {
                     );
                     return (err_expr(span), Ty::Err);
                 }
-                if is_arith(op) {
+                if is_arith(op) || is_bit_logic(op) {
                     let ty = known(&t).unwrap_or(a.ty.clone());
                     (
                         Expr {
@@ -200,6 +205,40 @@ impl Cx<'_, '_> {
                 }
             }
         }
+    }
+
+    /// `a << n`, `a >> n`: `a` an integer, whose type the result has; `n`
+    /// an integer of any type (a literal amount is a `u32`, as in Rust).
+    fn shift(&mut self, op: BinOp, l: &ast::Expr, r: &ast::Expr, span: Span) -> (Expr, Ty) {
+        let (a, ta) = self.infer(l, None);
+        let (mut b, tb) = self.infer(r, None);
+        if matches!(ta, Ty::Err) || matches!(tb, Ty::Err) {
+            return (err_expr(span), Ty::Err);
+        }
+        let int = |t: &Ty| matches!(t, Ty::IntLit | Ty::Known(Type::Int(_)));
+        for (t, side) in [(&ta, l.span), (&tb, r.span)] {
+            if !int(t) {
+                let n = self.ty_name(t);
+                self.mismatch(
+                    side,
+                    format!("`{}` shifts integers; this is {n}", op.symbol()),
+                    format!("{n} here"),
+                );
+                return (err_expr(span), Ty::Err);
+            }
+        }
+        if tb == Ty::IntLit {
+            self.fix_literals(&mut b, &Type::Int(crate::ir::IntTy::U32));
+        }
+        let ty = known(&ta).unwrap_or(a.ty.clone());
+        (
+            Expr {
+                kind: ExprKind::binary(op, a, b),
+                ty,
+                span,
+            },
+            ta,
+        )
     }
 
     /// Infer an operand whose expected type is unknown because of an error

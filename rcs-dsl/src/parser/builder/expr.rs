@@ -15,7 +15,61 @@ struct Operand<'i> {
 
 impl Builder {
     pub(in crate::parser) fn expr(&mut self, p: Pair<Rule>) -> Expr {
-        self.expr_at(p, 0)
+        let e = self.expr_at(p, 0);
+        self.bitwise_beside_comparison(&e);
+        e
+    }
+
+    /// `w & 0x4F == 7` is `(w & 0x4F) == 7` in Rust but `w & (0x4F == 7)`
+    /// in C: a bitwise operator and a comparison side by side without
+    /// parentheses is refused, with the parenthesised form as help.
+    fn bitwise_beside_comparison(&mut self, e: &Expr) {
+        let mut stack = vec![e];
+        while let Some(e) = stack.pop() {
+            match &e.kind {
+                ExprKind::Binary(op, operands) => {
+                    for child in operands.iter() {
+                        if let ExprKind::Binary(inner, _) = &child.kind {
+                            let mixed = (op.is_comparison() && inner.is_bitwise())
+                                || (op.is_bitwise() && inner.is_comparison());
+                            if mixed {
+                                self.mixed_bitwise(e, *op, *inner);
+                            }
+                        }
+                    }
+                    stack.extend(operands.iter());
+                }
+                ExprKind::Unary(_, x) | ExprKind::Cast(x, _) | ExprKind::Paren(x) => stack.push(x),
+                ExprKind::Field(x, _) => stack.push(x),
+                ExprKind::Index(x, i) => {
+                    stack.push(x);
+                    stack.push(i);
+                }
+                ExprKind::Call(_, args) => stack.extend(args.iter()),
+                _ => {}
+            }
+        }
+    }
+
+    fn mixed_bitwise(&mut self, whole: &Expr, op: BinOp, inner_op: BinOp) {
+        let (bitwise, comparison) = if op.is_bitwise() {
+            (op, inner_op)
+        } else {
+            (inner_op, op)
+        };
+        self.error(
+            whole.span,
+            format!(
+                "`{}` and `{}` side by side need parentheses",
+                bitwise.symbol(),
+                comparison.symbol()
+            ),
+            "bitwise operator beside a comparison",
+        );
+        let (b, c) = (bitwise.symbol(), comparison.symbol());
+        self.diags.last_mut().expect("just pushed").help = Some(format!(
+            "Rust and C read this in opposite orders: put the part meant first in parentheses, `(word {b} mask) {c} value`"
+        ));
     }
 
     pub(in crate::parser) fn too_deep(&mut self, span: Span) -> Expr {
@@ -241,7 +295,9 @@ impl Builder {
         };
         let mut height = 1;
         let kind = match p.as_rule() {
-            Rule::number if p.as_str().contains(['.', 'e', 'E']) => {
+            Rule::number
+                if !p.as_str().starts_with("0x") && p.as_str().contains(['.', 'e', 'E']) =>
+            {
                 match without_underscores(p.as_str()).parse::<f64>() {
                     Ok(v) if v.is_finite() => ExprKind::Float(v),
                     _ => {
@@ -250,7 +306,7 @@ impl Builder {
                     }
                 }
             }
-            Rule::number => match without_underscores(p.as_str()).parse::<u64>() {
+            Rule::number => match parse_int(p.as_str()) {
                 Ok(v) => ExprKind::Int(v),
                 _ => {
                     self.error(

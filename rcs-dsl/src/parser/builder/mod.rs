@@ -78,7 +78,7 @@ impl Builder {
 
     pub(in crate::parser) fn int(&mut self, p: Pair<Rule>) -> u64 {
         let span = self.span(&p);
-        match without_underscores(p.as_str()).parse::<u64>() {
+        match parse_int(p.as_str()) {
             Ok(v) => v,
             Err(_) => {
                 self.error(
@@ -202,8 +202,27 @@ fn bin_op(s: &str) -> BinOp {
         "-" => BinOp::Sub,
         "*" => BinOp::Mul,
         "/" => BinOp::Div,
+        "&" => BinOp::BitAnd,
+        "|" => BinOp::BitOr,
+        "^" => BinOp::BitXor,
+        "<<" => BinOp::Shl,
+        ">>" => BinOp::Shr,
         _ => BinOp::Rem,
     }
+}
+
+/// An integer literal: decimal, `0x` hex or `0b` binary, `_` allowed.
+pub(in crate::parser) fn parse_int(s: &str) -> Result<u64, ()> {
+    let (digits, radix) = match s.get(..2) {
+        Some("0x") => (&s[2..], 16),
+        Some("0b") => (&s[2..], 2),
+        _ => (s, 10),
+    };
+    let digits = without_underscores(digits);
+    if digits.is_empty() {
+        return Err(());
+    }
+    u64::from_str_radix(&digits, radix).map_err(|_| ())
 }
 
 /// A number's digits without its `_` separators (borrowed when it has

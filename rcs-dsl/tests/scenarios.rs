@@ -25,6 +25,7 @@ fn every_plan_scenario_passes() {
         "../plans/figure13",
         "../plans/rcs_ex",
         "../plans/bridgeport_io",
+        "../plans/packml",
     ] {
         let loaded = load_folder(Path::new(set)).expect("plans");
         let ir = check(&loaded, &Options::default()).ir.expect("clean");

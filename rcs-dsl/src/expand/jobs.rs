@@ -272,10 +272,14 @@ impl Lists<'_> {
             if !sound {
                 continue;
             }
-            for (param, arg) in list.params.iter().zip(args) {
-                for j in &mut jobs {
-                    substitute_job(j, &param.name, arg, diags);
-                }
+            // All parameters at once: replaced one after another, an
+            // argument naming a later parameter (`inner(y, x)` inside a
+            // list with parameters `x, y`, or a var `y` passed for `x`)
+            // would be replaced again.
+            let bound: Vec<(&Name, &Expr)> =
+                list.params.iter().map(|p| &p.name).zip(args).collect();
+            for j in &mut jobs {
+                substitute_job(j, &bound, diags);
             }
             if let Some(phase) = phase {
                 jobs.retain(|j| {
@@ -419,12 +423,13 @@ fn job_exprs_outside_call(job: &Job) -> Vec<&Expr> {
     }
 }
 
-/// Replace `param` by `arg` in a job.
-fn substitute_job(job: &mut Job, param: &Name, arg: &Expr, diags: &mut Diagnostics) {
+/// Replace each parameter by its argument in a job, all at once.
+fn substitute_job(job: &mut Job, bound: &[(&Name, &Expr)], diags: &mut Diagnostics) {
     match job {
-        Job::Send { args, .. } => args.iter_mut().for_each(|(_, e)| substitute(e, param, arg)),
+        Job::Send { args, .. } => args.iter_mut().for_each(|(_, e)| substitute(e, bound)),
         Job::Assign { place, value, .. } => {
-            if place_root(place) == Some(param.text.as_str()) {
+            let root = place_root(place);
+            if let Some((param, _)) = bound.iter().find(|(p, _)| root == Some(p.text.as_str())) {
                 diags.push(
                     Diagnostic::error(
                         Code::JobList,
@@ -435,12 +440,12 @@ fn substitute_job(job: &mut Job, param: &Name, arg: &Expr, diags: &mut Diagnosti
                     .with_help("assign to a var or a `writes` buffer field instead"),
                 );
             }
-            substitute(place, param, arg);
-            substitute(value, param, arg);
+            substitute(place, bound);
+            substitute(value, bound);
         }
-        Job::Call(e) => substitute(e, param, arg),
+        Job::Call(e) => substitute(e, bound),
         Job::ReportCode(_, code, _) => {
-            if code.text == param.text {
+            if let Some((_, arg)) = bound.iter().find(|(p, _)| p.text == code.text) {
                 if let ExprKind::Path(None, n) = &arg.kind {
                     *code = n.clone();
                 }
@@ -450,12 +455,17 @@ fn substitute_job(job: &mut Job, param: &Name, arg: &Expr, diags: &mut Diagnosti
     }
 }
 
-fn substitute(e: &mut Expr, param: &Name, arg: &Expr) {
+/// Replace each parameter named in `e` by its argument; an argument put in
+/// is not looked into again.
+fn substitute(e: &mut Expr, bound: &[(&Name, &Expr)]) {
     e.walk_mut(&mut |x| match &x.kind {
-        ExprKind::Path(None, n) if n.text == param.text => {
-            *x = arg.clone();
-            false
-        }
+        ExprKind::Path(None, n) => match bound.iter().find(|(p, _)| p.text == n.text) {
+            Some((_, arg)) => {
+                *x = (*arg).clone();
+                false
+            }
+            None => true,
+        },
         _ => true,
     });
 }

@@ -93,14 +93,21 @@ pub(crate) struct Step {
     pub(crate) hooks: Vec<Option<Value>>,
     /// Per subordinate, an answer.
     pub(crate) subs: Vec<Option<Answer>>,
+    /// Then every subordinate answers its latest command with DONE (a
+    /// supervisor waiting for all of them is otherwise rarely answered).
+    pub(crate) all_done: bool,
     pub(crate) cycles: u32,
 }
 
-/// A sequence: the world's first `reads` values, the plan's verb with these
-/// arguments, then the steps.
+/// A sequence: the world's first `reads` values, perhaps a world model to
+/// start from, the plan's verb with these arguments, then the steps.
 #[derive(Clone, Debug)]
 pub(crate) struct Sequence {
     pub(crate) reads: Vec<Option<Value>>,
+    /// One value per var (status fields included), set before the first
+    /// command as a scenario's `initial: vars` does; `None` starts from
+    /// the declared initial values.
+    pub(crate) vars: Option<Vec<Value>>,
     pub(crate) args: Vec<Value>,
     pub(crate) steps: Vec<Step>,
 }
@@ -288,14 +295,33 @@ impl<'a> Values<'a> {
         bad
     }
 
-    /// Sequences for the plan of command `verb` of `c`.
+    /// Sequences for the plan of command `verb` of `c`. With `explore`,
+    /// one sequence in two starts from a world model of random values, and
+    /// about one step in three ends with every subordinate answering DONE: a plan
+    /// valid only in some states of its vars, waiting each time for all
+    /// its subordinates (a PackML unit's commands), is reached no other
+    /// way in thirty steps. Without it every sequence starts from the
+    /// declared initial values and no step is added, and no randomness is
+    /// drawn for either, so the sequences stay what they were.
     pub(crate) fn sequences(
         &self,
         c: &Controller,
         read_leaves: &[Vec<(Vec<usize>, Type)>],
         verb: usize,
+        explore: bool,
     ) -> impl Strategy<Value = Sequence> {
         let ir = self.ir;
+        let vars = if explore && !c.vars.is_empty() {
+            let each: Vec<_> = c.vars.iter().map(|v| self.of(&v.ty)).collect();
+            proptest::option::weighted(0.5, each).boxed()
+        } else {
+            Just(None).boxed()
+        };
+        let all_done = if explore && !c.subordinates.is_empty() {
+            proptest::bool::weighted(0.3).boxed()
+        } else {
+            Just(false).boxed()
+        };
         let commands: Vec<_> = (0..c.commands.len())
             .map(|v| self.args(c, v).prop_map(move |a| (v, a)).boxed())
             .collect();
@@ -370,21 +396,28 @@ impl<'a> Values<'a> {
                 })
                 .collect();
         let cycles = prop_oneof![98 => Just(1u32), 2 => 50u32..=300];
-        let step = (command, bad, updates, hooks, subs, cycles).prop_map(
-            |(command, bad, reads, hooks, subs, cycles)| Step {
+        let step = (command, bad, updates, hooks, subs, all_done, cycles).prop_map(
+            |(command, bad, reads, hooks, subs, all_done, cycles)| Step {
                 command,
                 bad,
                 reads,
                 hooks,
                 subs,
+                all_done,
                 cycles,
             },
         );
         (
             whole,
+            vars,
             self.args(c, verb),
             proptest::collection::vec(step, 1..=MAX_STEPS),
         )
-            .prop_map(|(reads, args, steps)| Sequence { reads, args, steps })
+            .prop_map(|(reads, vars, args, steps)| Sequence {
+                reads,
+                vars,
+                args,
+                steps,
+            })
     }
 }

@@ -30,9 +30,13 @@
 //!
 //! The test is not vacuous: every row of every plan must fire on both
 //! backends in some sequence (a plan whose rows have not all fired after
-//! 1,000 sequences gets up to four more rounds of 1,000), except the rows
-//! listed in [`NEVER_FIRE`], each of which provably cannot fire (and must
-//! indeed never fire); and `a_swapped_row_is_caught` shows that a code
+//! 1,000 sequences gets up to seven more rounds of 1,000, which explore
+//! further: one sequence in two starts from random values of the
+//! controller's vars and status fields, as a scenario's `initial: vars`
+//! may, and about one step in three ends with every subordinate answering its
+//! latest command DONE), except the rows listed in [`NEVER_FIRE`], each of
+//! which provably cannot fire from the declared initial values (and must
+//! indeed never fire from them); and `a_swapped_row_is_caught` shows that a code
 //! generator that gets row precedence wrong is caught, as a divergence
 //! rather than a crash.
 //!

@@ -119,7 +119,11 @@ fn compare(ir: &Ir, ty: &str, members: &[usize], group_of: &[Option<usize>]) -> 
     // slot must differ somewhere to be worth a field).
     let mut slot_of = BTreeMap::new();
     let mut out: Vec<Slot> = Vec::new();
-    for (addr, (ty, values)) in slots.by_addr {
+    let Slots { mut by_addr, order } = slots;
+    for addr in order {
+        let Some((ty, values)) = by_addr.remove(&addr) else {
+            continue;
+        };
         let values: Vec<ExprKind> = values
             .into_iter()
             .map(|v| v.expect("every member compared"))
@@ -147,6 +151,10 @@ fn compare(ir: &Ir, ty: &str, members: &[usize], group_of: &[Option<usize>]) -> 
 struct Slots {
     /// Template expression address → (type, value per member).
     by_addr: BTreeMap<usize, (Type, Vec<Option<ExprKind>>)>,
+    /// The addresses in the order the comparison first met them: the
+    /// template's structure order, so that slots are numbered the same on
+    /// every run (addresses are not).
+    order: Vec<usize>,
 }
 
 struct Cmp<'a> {
@@ -446,6 +454,9 @@ impl Cmp<'_> {
     fn record(&mut self, x: &Expr, xv: Option<ExprKind>, yv: Option<ExprKind>) {
         let addr = x as *const Expr as usize;
         let members = self.members;
+        if !self.slots.by_addr.contains_key(&addr) {
+            self.slots.order.push(addr);
+        }
         let entry = self
             .slots
             .by_addr
@@ -704,6 +715,34 @@ controller type M(k: u8, n: u8) {
         assert_eq!(g.slots.len(), 1);
         assert_eq!(g.slots[0].values, [1, 2, 1].map(rcs_dsl::ir::ExprKind::Int));
         assert_eq!(g.slot_of.len(), 4, "every use of `k` is a slot");
+    }
+
+    #[test]
+    fn slots_are_numbered_in_the_order_the_plans_use_them() {
+        let text = "controller type T(a: u8, b: u16, c: u32) {
+    command GO
+    var x: u32 = c
+    var y: u16 = 0
+    var z: u8 = 0
+    plan GO {
+        E0: *0 when new_command -> S1 { y = b }
+        E1: S1 when true -> Done { z = a }
+    }
+}
+controller P = T(a: 1, b: 2, c: 3)
+controller Q = T(a: 4, b: 5, c: 6)
+";
+        let (_, s) = sharing(text);
+        let kinds: Vec<String> = s.groups[0]
+            .slots
+            .iter()
+            .map(|slot| format!("{:?}", slot.values))
+            .collect();
+        // vars first (c), then the plan's rows in order (b, then a).
+        assert_eq!(
+            kinds,
+            ["[Int(3), Int(6)]", "[Int(2), Int(5)]", "[Int(1), Int(4)]"]
+        );
     }
 
     #[test]

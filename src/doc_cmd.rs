@@ -261,7 +261,21 @@ fn render_all(graphs: &[GraphSource]) -> Result<Option<Svgs>, String> {
     if !dot_installed() {
         return Ok(None);
     }
-    let batches: Vec<&[GraphSource]> = graphs.chunks(GRAPHS_PER_DOT).collect();
+    // A graph with clusters (a hierarchy) gets a `dot` of its own: after
+    // other graphs in one process, Graphviz 2.43 writes clusters in an
+    // order that changes from run to run (seen on `plans/`' site).
+    let mut batches: Vec<&[GraphSource]> = Vec::new();
+    let mut start = 0;
+    for (i, g) in graphs.iter().enumerate() {
+        if g.dot.contains("subgraph \"cluster") {
+            if start < i {
+                batches.extend(graphs[start..i].chunks(GRAPHS_PER_DOT));
+            }
+            batches.push(&graphs[i..=i]);
+            start = i + 1;
+        }
+    }
+    batches.extend(graphs[start..].chunks(GRAPHS_PER_DOT));
     let workers = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1)

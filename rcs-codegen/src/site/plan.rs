@@ -290,11 +290,56 @@ fn source(body: &mut String, plan: &Plan, text: &str, file: &str) {
         "<h2>Source</h2>\n<p class=\"file\">{}, lines {first}–{last}</p>\n<pre class=\"source\">",
         esc(file)
     );
+    source_lines(body, text, first..=last, &row_at);
+    body.push_str("</pre>\n");
+    // Rows placed by `use` and states first named in them are written in
+    // their `rows` block, outside the plan's lines: those lines follow, so
+    // that every row and state links to where it is written.
+    let mut shared: Vec<std::ops::RangeInclusive<usize>> = Vec::new();
+    let spans = plan
+        .rows
+        .iter()
+        .map(|r| r.span)
+        .chain(plan.states.iter().filter_map(|s| s.span))
+        .filter(|s| s.file == plan.span.file);
+    for span in spans {
+        let (a, b) = (
+            line_of(text, span.start),
+            line_of(text, span.end.saturating_sub(1).max(span.start)),
+        );
+        if (first..=last).contains(&a) || shared.iter().any(|r| r.contains(&a)) {
+            continue;
+        }
+        shared.push(a..=b);
+    }
+    shared.sort_by_key(|r| *r.start());
+    if shared.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        body,
+        "<p class=\"file\">{}: the shared rows this plan uses</p>\n<pre class=\"source\">",
+        esc(file)
+    );
+    for lines in shared {
+        source_lines(body, text, lines, &row_at);
+    }
+    body.push_str("</pre>\n");
+}
+
+/// Lines of `text`, each with its `L{n}` anchor and a link to its row.
+fn source_lines(
+    body: &mut String,
+    text: &str,
+    lines: std::ops::RangeInclusive<usize>,
+    row_at: &BTreeMap<usize, String>,
+) {
+    let (first, last) = (*lines.start(), *lines.end());
     for (i, line) in text
         .lines()
         .enumerate()
-        .skip(first - 1)
-        .take(last + 1 - first)
+        .skip(first.saturating_sub(1))
+        .take((last + 1).saturating_sub(first))
     {
         let n = i + 1;
         let number = match row_at.get(&n) {
@@ -309,5 +354,4 @@ fn source(body: &mut String, plan: &Plan, text: &str, file: &str) {
             esc(line)
         );
     }
-    body.push_str("</pre>\n");
 }

@@ -115,6 +115,33 @@ fn nan_is_neither_below_nor_at_or_above() {
     assert_eq!(run(0, 1, f64::NAN, 0).1, "E3");
 }
 
+/// `x << s` and `x >> s` as `arith::bitwise` computes them for type `$ty`,
+/// against Rust's `checked_shl`/`checked_shr` on `x`'s own type (0 where
+/// Rust has no result).
+macro_rules! shifts_as_rust {
+    ($x:expr, $s:expr, $ty:expr) => {{
+        let (x, s) = ($x, $s);
+        let want_l = u32::try_from(s)
+            .ok()
+            .and_then(|s| x.checked_shl(s))
+            .unwrap_or(0);
+        let want_r = u32::try_from(s)
+            .ok()
+            .and_then(|s| x.checked_shr(s))
+            .unwrap_or(0);
+        assert_eq!(
+            rcs_dsl::arith::bitwise(rcs_dsl::ast::BinOp::Shl, i128::from(x), s, $ty),
+            i128::from(want_l),
+            "{x} << {s}"
+        );
+        assert_eq!(
+            rcs_dsl::arith::bitwise(rcs_dsl::ast::BinOp::Shr, i128::from(x), s, $ty),
+            i128::from(want_r),
+            "{x} >> {s}"
+        );
+    }};
+}
+
 /// Bitwise operators and shifts (LANGUAGE.md §8), against Rust's own on
 /// the same types: `&`, `|`, `^`, `!` wrap to the type; a shift by the
 /// width or more, or by a negative amount, is 0; `>>` of a signed value is
@@ -138,46 +165,12 @@ fn bitwise_and_shifts_follow_rust_and_never_panic() {
             );
         }
         for s in [-1i128, 0, 1, 7, 15, 16, 17, 200] {
-            let want_l = u32::try_from(s)
-                .ok()
-                .and_then(|s| x.checked_shl(s))
-                .unwrap_or(0);
-            let want_r = u32::try_from(s)
-                .ok()
-                .and_then(|s| x.checked_shr(s))
-                .unwrap_or(0);
-            assert_eq!(
-                bitwise(BinOp::Shl, i128::from(x), s, IntTy::U16),
-                i128::from(want_l),
-                "{x} << {s}"
-            );
-            assert_eq!(
-                bitwise(BinOp::Shr, i128::from(x), s, IntTy::U16),
-                i128::from(want_r),
-                "{x} >> {s}"
-            );
+            shifts_as_rust!(x, s, IntTy::U16);
         }
     }
     for x in [i8::MIN, -5, -1, 0, 1, 100, i8::MAX] {
         for s in [-3i128, 0, 1, 6, 7, 8, 9] {
-            let want_l = u32::try_from(s)
-                .ok()
-                .and_then(|s| x.checked_shl(s))
-                .unwrap_or(0);
-            let want_r = u32::try_from(s)
-                .ok()
-                .and_then(|s| x.checked_shr(s))
-                .unwrap_or(0);
-            assert_eq!(
-                bitwise(BinOp::Shl, i128::from(x), s, IntTy::I8),
-                i128::from(want_l),
-                "{x} << {s}"
-            );
-            assert_eq!(
-                bitwise(BinOp::Shr, i128::from(x), s, IntTy::I8),
-                i128::from(want_r),
-                "{x} >> {s}"
-            );
+            shifts_as_rust!(x, s, IntTy::I8);
         }
         let not = rcs_dsl::arith::unary(
             rcs_dsl::ast::UnOp::Not,

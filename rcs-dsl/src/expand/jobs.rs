@@ -195,7 +195,7 @@ impl Lists<'_> {
     /// A job list called inside an expression (a condition, an argument).
     fn in_condition(&self, e: Option<&Expr>, diags: &mut Diagnostics) {
         let Some(e) = e else { return };
-        visit(e, &mut |x| {
+        e.walk(&mut |x| {
             if let ExprKind::Call(name, _) = &x.kind {
                 if self.find(&name.text).is_some() {
                     diags.push(
@@ -323,7 +323,7 @@ fn check_argument(
 ) -> bool {
     let mut reads = Vec::new();
     let mut calls_hook = None;
-    visit(arg, &mut |x| match &x.kind {
+    arg.walk(&mut |x| match &x.kind {
         ExprKind::Path(None, n) => reads.push(n.text.clone()),
         ExprKind::Call(n, _) if crate::builtin::Builtin::from_name(&n.text).is_none() => {
             calls_hook.get_or_insert(n.span);
@@ -386,9 +386,7 @@ fn place_root(e: &Expr) -> Option<&str> {
 fn uses(job: &Job, param: &str) -> bool {
     let mut found = false;
     for e in job_all_exprs(job) {
-        visit(e, &mut |x| {
-            found |= matches!(&x.kind, ExprKind::Path(None, n) if n.text == param)
-        });
+        e.walk(&mut |x| found |= matches!(&x.kind, ExprKind::Path(None, n) if n.text == param));
     }
     found || matches!(job, Job::ReportCode(_, code, _) if code.text == param)
 }
@@ -468,9 +466,4 @@ fn substitute(e: &mut Expr, bound: &[(&Name, &Expr)]) {
         },
         _ => true,
     });
-}
-
-/// Call `f` on `e` and every sub-expression.
-fn visit<'a>(e: &'a Expr, f: &mut dyn FnMut(&'a Expr)) {
-    e.walk(f)
 }

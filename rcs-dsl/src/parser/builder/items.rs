@@ -51,57 +51,16 @@ impl Builder {
                 })
             }
             Rule::controller_def => {
-                inner.next();
-                let name = self.name(inner.next()?);
-                let mut title = None;
-                let mut entries = Vec::with_capacity(inner.len());
-                for c in inner {
-                    match c.as_rule() {
-                        Rule::string_lit => title = Some(Self::title(&c)),
-                        Rule::entry => {
-                            if let Some(e) = self.entry(c) {
-                                entries.push(e);
-                            }
-                        }
-                        _ => {}
-                    }
-                }
-                Item::Controller(ControllerDef {
-                    outer,
-                    name,
-                    title,
-                    entries,
-                    span,
-                    instance: None,
-                })
+                inner.next(); // controller
+                let (def, _) = self.controller_body(inner, outer, span)?;
+                Item::Controller(def)
             }
             Rule::const_def => Item::Const(self.const_def(def)?),
             Rule::controller_type_def => {
                 inner.next(); // controller
                 inner.next(); // type
-                let name = self.name(inner.next()?);
-                let mut title = None;
-                let mut params = Vec::new();
-                let mut entries = Vec::with_capacity(inner.len());
-                for c in inner {
-                    match c.as_rule() {
-                        Rule::string_lit => title = Some(Self::title(&c)),
-                        Rule::param => params.extend(self.params(std::iter::once(c))),
-                        Rule::entry => entries.extend(self.entry(c)),
-                        _ => {}
-                    }
-                }
-                Item::ControllerType(ControllerTypeDef {
-                    def: ControllerDef {
-                        outer,
-                        name,
-                        title,
-                        entries,
-                        span,
-                        instance: None,
-                    },
-                    params,
-                })
+                let (def, params) = self.controller_body(inner, outer, span)?;
+                Item::ControllerType(ControllerTypeDef { def, params })
             }
             Rule::instance_def => {
                 inner.next(); // controller
@@ -147,6 +106,38 @@ impl Builder {
         let span = self.span(&p);
         let name = self.name(p.into_inner().nth(1)?);
         Some(Use { at, name, span })
+    }
+
+    /// A controller's or a type's name, title, parameters (a type's) and
+    /// entries, from the name on.
+    fn controller_body<'i>(
+        &mut self,
+        mut inner: impl Iterator<Item = Pair<'i, Rule>>,
+        outer: Outer,
+        span: Span,
+    ) -> Option<(ControllerDef, Vec<Param>)> {
+        let name = self.name(inner.next()?);
+        let mut title = None;
+        let mut params = Vec::new();
+        // Sized once, as the entries are most of a controller.
+        let mut entries = Vec::with_capacity(inner.size_hint().0);
+        for c in inner {
+            match c.as_rule() {
+                Rule::string_lit => title = Some(Self::title(&c)),
+                Rule::param => params.extend(self.params(std::iter::once(c))),
+                Rule::entry => entries.extend(self.entry(c)),
+                _ => {}
+            }
+        }
+        let def = ControllerDef {
+            outer,
+            name,
+            title,
+            entries,
+            span,
+            instance: None,
+        };
+        Some((def, params))
     }
 
     /// A title string's text.

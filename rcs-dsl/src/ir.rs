@@ -664,6 +664,10 @@ pub enum ExprKind {
     PlanCycles,
     /// Parameter of the command being executed; only in the plan of that command.
     CmdParam(CommandId, ParamId),
+    /// `cmd.P` in `pre` or `post`: parameter P of the command being
+    /// executed, for each verb that declares it (all with one type); the
+    /// type's zero before the first command and while a verb without P runs.
+    CurrentParam(Vec<(CommandId, ParamId)>),
     Var(VarId),
     /// A `reads` or `writes` buffer as a whole.
     Buffer(BufferId),

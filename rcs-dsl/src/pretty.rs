@@ -65,6 +65,12 @@ impl<'a> Printer<'a> {
                 out.push_str("cmd.");
                 out.push_str(&self.ctrl.commands[c.index()].params[p.index()].name);
             }
+            ExprKind::CurrentParam(verbs) => {
+                out.push_str("cmd.");
+                if let Some((c, p)) = verbs.first() {
+                    out.push_str(&self.ctrl.commands[c.index()].params[p.index()].name);
+                }
+            }
             ExprKind::Var(v) => out.push_str(&self.ctrl.vars[v.index()].name),
             ExprKind::Buffer(b) => out.push_str(&self.ir.buffers[b.index()].name),
             ExprKind::Field(base, f) => {

@@ -279,6 +279,24 @@ impl Gen<'_> {
                 let local = prefixed("cmd", &self.cn().params[c.index()][p.index()]);
                 Code::atom(quote!(#local))
             }
+            // `cmd.P` in `pre`/`post`: the running verb's P, else zero
+            // (`data.command` is the default command, of zeros, before the
+            // first one arrives).
+            ExprKind::CurrentParam(verbs) => {
+                let n = self.cn();
+                let arms = verbs.iter().map(|(c, p)| {
+                    let v = &n.commands[c.index()];
+                    let f = &n.params[c.index()][p.index()];
+                    quote!(Command::#v { #f: value, .. })
+                });
+                let rest = if verbs.len() < self.ctrl.commands.len() {
+                    let z = zero(self.names, &e.ty);
+                    quote!(_ => #z,)
+                } else {
+                    quote!()
+                };
+                Code::atom(quote!(match self.data.command { #(#arms)|* => value, #rest }))
+            }
             ExprKind::Var(v) => {
                 let id = &self.cn().vars[v.index()];
                 Code::atom(quote!(self.data.vars.#id))

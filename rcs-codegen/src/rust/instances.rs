@@ -410,6 +410,7 @@ impl Cmp<'_> {
             | (K::StateCycles, K::StateCycles)
             | (K::PlanCycles, K::PlanCycles) => true,
             (K::CmdParam(c, p), K::CmdParam(d, q)) => c == d && p == q,
+            (K::CurrentParam(a), K::CurrentParam(b)) => a == b,
             (K::Var(i), K::Var(j)) => i == j,
             (K::Buffer(i), K::Buffer(j)) => {
                 Self::buffer_pos(self.a, *i).is_some()

@@ -30,6 +30,20 @@ impl Interpreter<'_> {
                 .get(p.index())
                 .cloned()
                 .unwrap_or(Value::Unit),
+            // `cmd.P` in `pre`/`post`: the running verb's P, else zero.
+            ExprKind::CurrentParam(verbs) => {
+                let running = (self.bk.echo_serial() != 0)
+                    .then(|| {
+                        verbs
+                            .iter()
+                            .find(|(v, _)| v.index() == usize::from(self.bk.verb()))
+                    })
+                    .flatten();
+                match running.and_then(|(_, p)| self.active_params.get(p.index())) {
+                    Some(v) => v.clone(),
+                    None => zero(self.ir, &e.ty),
+                }
+            }
             ExprKind::Var(v) => self.vars[v.index()].clone(),
             ExprKind::Buffer(b) => {
                 if let Some(i) = self.ctrl.writes.iter().position(|w| w == b) {

@@ -148,18 +148,59 @@ impl Cx<'_, '_> {
     }
 
     /// `cmd.P` outside any plan: only a `pre`/`post` block gets here (a var
-    /// initialiser is a constant context).
-    pub(in crate::lower) fn cmd_outside_plan(&mut self, span: Span, param: &str) -> (Expr, Ty) {
-        self.diags.push(
-            Diagnostic::error(
-                Code::UnknownName,
-                format!("`cmd.{param}` has no value in a `pre` or `post` block"),
+    /// initialiser is a constant context). It reads parameter P of the
+    /// command being executed (LANGUAGE.md §7): every verb that declares
+    /// P must declare it with one type; the value is that type's zero
+    /// before the first command and while a verb without P runs.
+    pub(in crate::lower) fn current_param(&mut self, span: Span, param: &str) -> (Expr, Ty) {
+        let mut verbs: Vec<(CommandId, ParamId, &Type)> = Vec::new();
+        for (ci, c) in self.c.commands.iter().enumerate() {
+            if let Some(pi) = c.params.iter().position(|p| p.name == param) {
+                verbs.push((CommandId(ci as u32), ParamId(pi as u32), &c.params[pi].ty));
+            }
+        }
+        let Some(&(first_verb, _, ty)) = verbs.first() else {
+            self.diags.push(
+                Diagnostic::error(
+                    Code::UnknownName,
+                    format!("no command of `{}` has a parameter `{param}`", self.c.name),
+                    span,
+                    "no such parameter",
+                )
+                .with_help(
+                    "`cmd.P` in `pre` and `post` reads parameter P of the command being executed",
+                ),
+            );
+            return (err_expr(span), Ty::Err);
+        };
+        if *ty == Type::Unit {
+            return (err_expr(span), Ty::Err);
+        }
+        if let Some(&(other, _, other_ty)) = verbs.iter().find(|(_, _, t)| *t != ty) {
+            let name = |v: CommandId| self.c.commands[v.index()].name.clone();
+            let (a, b) = (name(first_verb), name(other));
+            let (ta, tb) = (
+                crate::lower::type_name(self.ir, ty),
+                crate::lower::type_name(self.ir, other_ty),
+            );
+            self.mismatch(
                 span,
-                "no command here",
-            )
-            .with_help("`pre` and `post` run with or without a command; copy the parameter into a var in a plan's row and read the var"),
-        );
-        (err_expr(span), Ty::Err)
+                format!("`cmd.{param}` is a `{ta}` in `{a}` but a `{tb}` in `{b}`"),
+                "one name, two types".to_string(),
+            );
+            self.help_last("`pre` and `post` run whatever the command; give the parameter one type in every verb that has it");
+            return (err_expr(span), Ty::Err);
+        }
+        let ty = ty.clone();
+        let list = verbs.iter().map(|&(v, p, _)| (v, p)).collect();
+        (
+            Expr {
+                kind: ExprKind::CurrentParam(list),
+                ty: ty.clone(),
+                span,
+            },
+            Ty::Known(ty),
+        )
     }
 
     /// `X.NAME` where NAME is not a handshake property: status field NAME of

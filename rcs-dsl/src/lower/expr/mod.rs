@@ -261,7 +261,7 @@ impl Cx<'_, '_> {
             ast::ExprKind::CmdParam(p) => {
                 let Some(cmd) = self.plan_cmd else {
                     if !self.const_ctx {
-                        return self.cmd_outside_plan(span, &p.text);
+                        return self.current_param(span, &p.text);
                     }
                     return self.not_const(span, "a command parameter");
                 };

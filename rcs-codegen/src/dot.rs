@@ -280,6 +280,28 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
         );
     }
 
+    // Refusal (step 3a): when a command of the plan's verbs is taken.
+    let accepts: Vec<String> = plan
+        .verbs
+        .iter()
+        .filter_map(|v| {
+            let k = &ctrl.commands[v.index()];
+            let a = k.accept.as_ref()?;
+            Some(format!("{} accepted only when {}", k.name, p.expr(&a.cond)))
+        })
+        .collect();
+    if !accepts.is_empty() {
+        let _ = writeln!(
+            out,
+            "    \"accept\" [shape=note, fontsize=10, label=<{}>];",
+            accepts
+                .iter()
+                .map(|a| html(a))
+                .collect::<Vec<_>>()
+                .join("<br/>")
+        );
+    }
+
     // Nodes in order of first appearance in the rows.
     let mut emitted: Vec<String> = Vec::new();
     let mut node = |out: &mut String, id: String, r: &Row| {

@@ -104,6 +104,18 @@ pub fn controller_tables(ir: &Ir, ctrl: &Controller) -> String {
                     .join("\n")
             );
         }
+        // Refusal (step 3a): each verb of the plan with `accept when`.
+        for v in &plan.verbs {
+            let k = &ctrl.commands[v.index()];
+            if let Some(a) = &k.accept {
+                let _ = writeln!(
+                    out,
+                    "{} is accepted only when {}; otherwise it is refused: the running plan goes on and the sender sees ERROR (REFUSED).\n",
+                    k.name,
+                    code(&p.expr(&a.cond))
+                );
+            }
+        }
         let notes = plan.rows.iter().any(|r| !r.docs.is_empty());
         out.push_str("| Row | IF (event) | current state | THEN next state | job list |");
         out.push_str(if notes { " notes |\n" } else { "\n" });

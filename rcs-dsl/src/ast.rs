@@ -152,6 +152,14 @@ pub struct Entry {
     pub span: Span,
 }
 
+/// `accept when COND` on a command declaration.
+#[derive(Clone, Debug)]
+pub struct Accept {
+    /// The words `accept when`.
+    pub keyword: Span,
+    pub cond: Expr,
+}
+
 #[derive(Clone, Debug)]
 pub enum EntryKind {
     Level(u64, Span),
@@ -159,7 +167,12 @@ pub enum EntryKind {
     Subordinates(Vec<Name>),
     Reads(Name, Name),
     Writes(Name, Name),
-    Command(Name, Vec<Param>),
+    Command {
+        name: Name,
+        params: Vec<Param>,
+        /// `accept when COND` (§8): the command is refused when COND is false.
+        accept: Option<Accept>,
+    },
     Status(Vec<Name>),
     Error(Vec<Name>),
     Var {

@@ -65,11 +65,12 @@ pub enum Code {
     SharedRows,
     JobList,
     Instance,
+    AcceptCondition,
 }
 
 impl Code {
     /// Every hard-error code, in catalogue order (lints follow in [`Lint::ALL`]).
-    pub const ERRORS: [Code; 34] = [
+    pub const ERRORS: [Code; 35] = [
         Code::Syntax,
         Code::DuplicateDefinition,
         Code::UnknownName,
@@ -104,6 +105,7 @@ impl Code {
         Code::SharedRows,
         Code::JobList,
         Code::Instance,
+        Code::AcceptCondition,
     ];
 
     pub fn name(self) -> &'static str {
@@ -143,6 +145,7 @@ impl Code {
             Code::SharedRows => "shared_rows",
             Code::JobList => "job_list",
             Code::Instance => "instance",
+            Code::AcceptCondition => "accept_condition",
         }
     }
 
@@ -221,6 +224,9 @@ impl Code {
             }
             Code::Instance => {
                 "an instance names no controller type, or binds its buffers and subordinates wrongly"
+            }
+            Code::AcceptCondition => {
+                "an `accept when` condition calls a hook or reads a plan quantity of the plan it may replace"
             }
         }
     }

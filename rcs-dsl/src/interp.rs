@@ -236,12 +236,35 @@ impl<'ir> Interpreter<'ir> {
             verb.0 as u16,
             has_plan,
         );
-        if self.bk.new_command() {
-            self.active_params = params;
-        }
+        // 3a. A verb with `accept when` keeps what its refusal puts back.
+        let accept = self
+            .ctrl
+            .commands
+            .get(verb.index())
+            .and_then(|c| c.accept.as_ref())
+            .filter(|_| self.bk.new_command());
+        let before = if self.bk.new_command() {
+            let old = std::mem::replace(&mut self.active_params, params);
+            accept.map(|_| (old, self.vars.clone(), self.writes.clone()))
+        } else {
+            None
+        };
         // 3b. Pre-process, with or without an active plan.
         let mut sent = Vec::new();
         self.every_cycle(self.ctrl.pre.as_ref(), hooks);
+        // 3a. Refusal: judged after `pre`, on the arriving command.
+        if let (Some(a), Some((params, vars, writes))) = (accept, before) {
+            let taken = truthy(&self.eval(&a.cond, hooks));
+            if !taken && !self.bk.index_range_hit() {
+                // As if no command had arrived: the running plan's
+                // parameters, vars and buffers, and `pre` run on them.
+                self.bk.refuse();
+                self.active_params = params;
+                self.vars = vars;
+                self.writes = writes;
+                self.every_cycle(self.ctrl.pre.as_ref(), hooks);
+            }
+        }
         // 4. Decide (an index out of range skips the rest of the cycle's jobs).
         if self.bk.is_active() && !self.bk.index_range_hit() {
             self.decide(hooks, &mut sent);

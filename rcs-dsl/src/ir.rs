@@ -324,6 +324,20 @@ pub struct Command {
     pub params: Vec<Param>,
     pub plan: Option<PlanId>,
     pub span: Span,
+    /// `accept when COND` (§8, docs/semantics.md step 3a): a command of
+    /// this verb whose condition is false on its arrival cycle is refused.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accept: Option<Accept>,
+}
+
+/// The condition of `accept when COND`: it reads the arriving command's
+/// parameters (`CmdParam` of its verb), vars, status fields, buffers and
+/// subordinates; never a hook or a plan quantity.
+#[derive(Clone, Debug, Serialize)]
+pub struct Accept {
+    pub cond: Expr,
+    /// The words `accept when`.
+    pub span: Span,
 }
 
 #[derive(Clone, Debug, Serialize)]

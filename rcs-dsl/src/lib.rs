@@ -31,6 +31,7 @@ pub mod builtin;
 mod checks;
 pub mod diagnostic;
 pub mod diff;
+pub mod error_codes;
 mod expand;
 pub mod interp;
 pub mod ir;

@@ -8,9 +8,6 @@
 
 use proptest::prelude::*;
 use rcs_dsl::ir::Ir;
-use rcs_dsl::scenario::{self, Outcome};
-use rcs_dsl::source::SourceFile;
-use rcs_dsl::{check, Options, PlanSet};
 
 /// `A` drives subordinate `B` round a loop: every DONE of B is answered
 /// with a new command, an ERROR ends the plan, a silent B is noticed.
@@ -55,37 +52,12 @@ controller A {
 }
 "#;
 
+mod scenario_run;
+use rcs_dsl::scenario;
+use scenario_run::{failure, ir_of, parse, passes, run};
+
 fn ir() -> Ir {
-    let set = PlanSet::from_texts("t", [("t.rcs", PLANS)], None);
-    let out = check(&set, &Options::default());
-    out.ir.unwrap_or_else(|| panic!("{:?}", out.diagnostics))
-}
-
-fn parse(ir: &Ir, text: &str) -> Result<scenario::Scenario, (usize, String)> {
-    scenario::parse(ir, &SourceFile::new("t.scenario.yaml", text), "t")
-        .map_err(|e| (e.line, e.message))
-}
-
-fn run(ir: &Ir, text: &str) -> Outcome {
-    let s = parse(ir, text).unwrap_or_else(|e| panic!("{e:?}\n{text}"));
-    scenario::run(ir, &s)
-}
-
-fn passes(ir: &Ir, text: &str) {
-    let o = run(ir, text);
-    assert!(
-        o.failure.is_none(),
-        "{:?}; fired {:?}\n{text}",
-        o.failure,
-        o.fired
-    );
-}
-
-fn failure(ir: &Ir, text: &str) -> String {
-    run(ir, text)
-        .failure
-        .map(|f| f.1)
-        .unwrap_or_else(|| panic!("passes:\n{text}"))
+    ir_of(PLANS)
 }
 
 #[test]

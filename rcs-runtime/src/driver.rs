@@ -301,6 +301,13 @@ pub struct Record {
     pub status: Status,
     /// The error code after the cycle.
     pub error: ErrorCode,
+    /// The serial of the command the status is about (0: none yet).
+    #[serde(default)]
+    pub echo_serial: u32,
+    /// The serial of the command refused last (0: none), docs/semantics.md
+    /// step 3a: its sender sees `ERROR`/`REFUSED` for it.
+    #[serde(default)]
+    pub refused_serial: u32,
     /// Commands sent to subordinates this cycle, in subordinate order.
     pub sent: Vec<Sent>,
     /// The controller's vars after the cycle, in declaration order.

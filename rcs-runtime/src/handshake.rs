@@ -94,6 +94,11 @@ impl ErrorCode {
     /// [`INDEX_RANGE`](Self::INDEX_RANGE) at the top, so that declared
     /// codes keep their numbers.
     pub const HOOK_PANIC: ErrorCode = ErrorCode(u16::MAX - 1);
+    /// A command refused by its verb's `accept when` condition
+    /// (docs/semantics.md step 3a). Never in a controller's own status: a
+    /// supervisor's handshake view shows it for the serial named in
+    /// [`StatusBuffer::refused_serial`].
+    pub const REFUSED: ErrorCode = ErrorCode(u16::MAX - 2);
     /// The code of the first declared error.
     pub const FIRST_CUSTOM: u16 = 2;
 
@@ -113,6 +118,7 @@ impl ErrorCode {
         self.0 == Self::UNKNOWN_COMMAND.0
             || self.0 == Self::INDEX_RANGE.0
             || self.0 == Self::HOOK_PANIC.0
+            || self.0 == Self::REFUSED.0
     }
 }
 
@@ -154,6 +160,12 @@ impl<C: Command> CommandBuffer<C> {
 
 /// A controller's status buffer, plain data. All zeros before the first
 /// write: `{echo_serial: 0, echo_epoch: 0, NOT_READY, no error}`.
+///
+/// A refused command (docs/semantics.md step 3a) is not echoed: the echo
+/// stays on the command whose plan goes on, and `refused_serial` /
+/// `refused_epoch` name the command refused last, so that its sender sees
+/// `ERROR`/`REFUSED` until it sends again while the running plan's reports
+/// never answer it.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct StatusBuffer {
     /// Serial of the command this status is about.
@@ -168,6 +180,10 @@ pub struct StatusBuffer {
     pub verb: VerbId,
     /// The current state of its plan.
     pub state: StateId,
+    /// Serial of the command refused last (0: none).
+    pub refused_serial: u32,
+    /// Epoch of the command refused last.
+    pub refused_epoch: u32,
 }
 
 impl StatusBuffer {
@@ -292,6 +308,8 @@ impl SubordinateLink {
                     error: ErrorCode::NONE,
                     verb: 0,
                     state: 0,
+                    refused_serial: 0,
+                    refused_epoch: 0,
                 },
             },
             old_echoes: 0,
@@ -317,7 +335,14 @@ impl SubordinateLink {
         // Nothing sent: only "no command" (serial 0, whatever epoch) is ours.
         let ours = raw.echo_serial == self.last_sent
             && (self.last_sent == 0 || raw.echo_epoch == self.epoch);
-        let (status, error) = if ours {
+        let refused = self.last_sent != 0
+            && raw.refused_serial == self.last_sent
+            && raw.refused_epoch == self.epoch;
+        let (status, error) = if refused {
+            // Step 3a: the latest command was refused; the plan that goes on
+            // (whatever it echoes and reports) never answers it.
+            (Status::ERROR, ErrorCode::REFUSED)
+        } else if ours {
             (raw.status, raw.error)
         } else {
             // A status for an older command (of this incarnation, an earlier

@@ -151,6 +151,32 @@ pub struct Bookkeeping {
     verb_stats: Vec<VerbStats>,
     /// An index out of range was met this cycle (see [`Bookkeeping::index_range`]).
     index_range: bool,
+    /// The command refused last (step 3a): serial and epoch, 0 for none.
+    refused_serial: u32,
+    refused_epoch: u32,
+    /// The newest command taken from the command buffer, accepted or
+    /// refused, for counting lost commands.
+    last_serial: u32,
+    last_epoch: u32,
+    /// The plan as it stood before this cycle's new command, to put back
+    /// if the command is refused.
+    before: Before,
+}
+
+/// What step 3 changes, kept so that a refusal (step 3a) undoes it.
+#[derive(Debug, Clone, Copy)]
+struct Before {
+    echo_serial: u32,
+    echo_epoch: u32,
+    verb: VerbId,
+    state: StateId,
+    status: Status,
+    error: ErrorCode,
+    running: bool,
+    state_cycles: u32,
+    plan_cycles: u32,
+    started_at: Option<Instant>,
+    superseded: bool,
 }
 
 impl Bookkeeping {
@@ -174,6 +200,23 @@ impl Bookkeeping {
             started_at: None,
             verb_stats: vec![VerbStats::default(); verb_count],
             index_range: false,
+            refused_serial: 0,
+            refused_epoch: 0,
+            last_serial: 0,
+            last_epoch: 0,
+            before: Before {
+                echo_serial: 0,
+                echo_epoch: 0,
+                verb: 0,
+                state: S0,
+                status: Status::NOT_READY,
+                error: ErrorCode::NONE,
+                running: false,
+                state_cycles: 0,
+                plan_cycles: 0,
+                started_at: None,
+                superseded: false,
+            },
         }
     }
 
@@ -214,19 +257,39 @@ impl Bookkeeping {
         self.index_range = false;
         self.now = Some(tick.now);
         // Serial 0 is a buffer never written, whatever its epoch.
-        if serial == 0 || (serial == self.echo_serial && epoch == self.echo_epoch) {
+        // A refused command stays in the buffer until the next one: it is
+        // not new again.
+        if serial == 0
+            || (serial == self.echo_serial && epoch == self.echo_epoch)
+            || (serial == self.refused_serial && epoch == self.refused_epoch)
+        {
             self.new_command = false;
             return NewCommand::No;
         }
+        self.before = Before {
+            echo_serial: self.echo_serial,
+            echo_epoch: self.echo_epoch,
+            verb: self.verb,
+            state: self.state,
+            status: self.status,
+            error: self.error,
+            running: self.running,
+            state_cycles: self.state_cycles,
+            plan_cycles: self.plan_cycles,
+            started_at: self.started_at,
+            superseded: self.running,
+        };
         if self.running {
             if let Some(s) = self.verb_stats.get_mut(usize::from(self.verb)) {
                 s.superseded = s.superseded.saturating_add(1);
             }
         }
-        if self.echo_serial != 0 && epoch == self.echo_epoch && serial > self.echo_serial {
-            let skipped = serial - self.echo_serial - 1;
+        if self.last_serial != 0 && epoch == self.last_epoch && serial > self.last_serial {
+            let skipped = serial - self.last_serial - 1;
             self.commands_lost = self.commands_lost.saturating_add(u64::from(skipped));
         }
+        self.last_serial = serial;
+        self.last_epoch = epoch;
         self.new_command = true;
         self.echo_serial = serial;
         self.echo_epoch = epoch;
@@ -249,8 +312,52 @@ impl Bookkeeping {
         }
     }
 
-    /// Whether a plan is active and has not finished: only then are its rows
-    /// walked (step 4).
+    /// Step 3a: refuse this cycle's new command (its verb's `accept when`
+    /// condition is false). Everything step 3 changed is put back — the
+    /// running plan keeps its verb, state, counters, status and echo, and
+    /// `new_command` is false — and the status buffer names the command as
+    /// refused, so that its sender sees `ERROR`/`REFUSED` until it sends
+    /// again. Does nothing on a cycle without a new command.
+    #[inline]
+    pub fn refuse(&mut self) {
+        if !self.new_command {
+            return;
+        }
+        let b = self.before;
+        self.refused_serial = self.echo_serial;
+        self.refused_epoch = self.echo_epoch;
+        if b.superseded {
+            if let Some(s) = self.verb_stats.get_mut(usize::from(b.verb)) {
+                s.superseded = s.superseded.saturating_sub(1);
+            }
+        }
+        self.echo_serial = b.echo_serial;
+        self.echo_epoch = b.echo_epoch;
+        self.verb = b.verb;
+        self.state = b.state;
+        self.status = b.status;
+        self.error = b.error;
+        self.running = b.running;
+        self.state_cycles = b.state_cycles;
+        self.plan_cycles = b.plan_cycles;
+        self.started_at = b.started_at;
+        self.new_command = false;
+        self.fired = None;
+        self.index_range = false;
+    }
+
+    /// The serial of the command refused last (0: none).
+    pub fn refused_serial(&self) -> u32 {
+        self.refused_serial
+    }
+
+    /// The epoch of the command refused last (0: none).
+    pub fn refused_epoch(&self) -> u32 {
+        self.refused_epoch
+    }
+
+    /// Whether a plan is active and has not finished: only then are its
+    /// rows walked (step 4).
     #[inline]
     pub fn is_active(&self) -> bool {
         self.running
@@ -388,6 +495,8 @@ impl Bookkeeping {
             error: self.error,
             verb: self.verb,
             state: self.state,
+            refused_serial: self.refused_serial,
+            refused_epoch: self.refused_epoch,
         }
     }
 

@@ -60,7 +60,7 @@ impl<T: Schema, const N: usize> Schema for [T; N] {
 
 impl Schema for StatusBuffer {
     const SCHEMA: u64 = combine(
-        "StatusBuffer{echo_serial:u32,echo_epoch:u32,status:u16,error:u16,verb:u16,state:u16}",
+        "StatusBuffer{echo_serial:u32,echo_epoch:u32,status:u16,error:u16,verb:u16,state:u16,refused_serial:u32,refused_epoch:u32}",
         &[],
     );
 }

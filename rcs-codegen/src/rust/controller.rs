@@ -506,6 +506,20 @@ pub(crate) fn module(
         write: status_fields_write,
     } = super::every_cycle::parts(ir, names, ci, comments, shared.is_some());
     let (decide_call, post_call) = super::index::cycle_steps(&ir.controllers[ci], post_jobs);
+    // Step 3 and 3b: a controller that may refuse a command judges it after
+    // `pre` and puts everything back if it refuses (`accept`).
+    let (accept_method, step3_and_pre) = match super::accept::refusal(ir, names, ci, &pre_jobs) {
+        Some(r) => (r.method, r.cycle),
+        None => (
+            quote!(),
+            quote! {
+                if self.bk.new_command() {
+                    self.data.command = command.command;
+                }
+                #pre_jobs
+            },
+        ),
+    };
 
     let verb_count_lit = proc_macro2::Literal::usize_unsuffixed(verb_count);
     // The six steps of a cycle (docs/semantics.md), as comments in the output.
@@ -535,6 +549,24 @@ pub(crate) fn module(
         self_name,
         data_init,
     } = shape(names, c, name, shared, vars_for_instance);
+    // The built-in error REFUSED, only where a verb can be refused.
+    let refuses = c.commands.iter().any(|k| k.accept.is_some());
+    let (refused_const, refused_variant, refused_from_raw, refused_raw, refused_name) = if refuses {
+        (
+            quote! {
+                /// A command refused by its verb's `accept when` (seen by the sender only).
+                pub const REFUSED: rt::ErrorCode = rt::ErrorCode::REFUSED;
+            },
+            quote!(Refused,),
+            quote!(if raw.0 == error::REFUSED.0 {
+                return Some(Self::Refused);
+            }),
+            quote!(Self::Refused => error::REFUSED,),
+            quote!(Self::Refused => "REFUSED",),
+        )
+    } else {
+        Default::default()
+    };
     quote! {
         #mod_docs
         pub mod #module {
@@ -563,6 +595,7 @@ pub(crate) fn module(
                 pub const INDEX_RANGE: rt::ErrorCode = rt::ErrorCode::INDEX_RANGE;
                 /// A hook panicked; the executive caught it and ended the plan.
                 pub const HOOK_PANIC: rt::ErrorCode = rt::ErrorCode::HOOK_PANIC;
+                #refused_const
                 #(#error_consts)*
             }
 
@@ -587,13 +620,14 @@ pub(crate) fn module(
 
             /// An error code this controller reports.
             #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-            pub enum Error { UnknownCommand, IndexRange, HookPanic, #(#error_variants),* }
+            pub enum Error { UnknownCommand, IndexRange, HookPanic, #refused_variant #(#error_variants),* }
             impl Error {
                 /// The typed error of a runtime code (`None` for no error).
                 pub const fn from_raw(raw: rt::ErrorCode) -> Option<Self> {
                     if raw.0 == error::UNKNOWN_COMMAND.0 { return Some(Self::UnknownCommand); }
                     if raw.0 == error::INDEX_RANGE.0 { return Some(Self::IndexRange); }
                     if raw.0 == error::HOOK_PANIC.0 { return Some(Self::HookPanic); }
+                    #refused_from_raw
                     #(if raw.0 == error::#error_consts_ids.0 { return Some(Self::#error_variants); })*
                     None
                 }
@@ -603,6 +637,7 @@ pub(crate) fn module(
                         Self::UnknownCommand => error::UNKNOWN_COMMAND,
                         Self::IndexRange => error::INDEX_RANGE,
                         Self::HookPanic => error::HOOK_PANIC,
+                        #refused_raw
                         #(Self::#error_variants => error::#error_consts_ids),*
                     }
                 }
@@ -612,6 +647,7 @@ pub(crate) fn module(
                         Self::UnknownCommand => "UNKNOWN_COMMAND",
                         Self::IndexRange => "INDEX_RANGE",
                         Self::HookPanic => "HOOK_PANIC",
+                        #refused_name
                         #(Self::#error_variants => #error_names),*
                     }
                 }
@@ -725,6 +761,7 @@ pub(crate) fn module(
                 }
 
                 #decide
+                #accept_method
 
                 #(#plan_fns)*
             }
@@ -742,10 +779,7 @@ pub(crate) fn module(
                     self.data.subs = subs;
                     #step3
                     self.bk.begin_cycle(ctx.tick(), &command, true);
-                    if self.bk.new_command() {
-                        self.data.command = command.command;
-                    }
-                    #pre_jobs
+                    #step3_and_pre
                     #step4
                     #decide_call
                     #post_call

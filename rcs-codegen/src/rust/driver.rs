@@ -284,6 +284,9 @@ pub(crate) fn driver_parts(ir: &Ir, names: &Names, ci: usize, part: DriverPart) 
                 if status.echo_epoch == 0 {
                     status.echo_epoch = self.#sub_cmd.read().value.epoch;
                 }
+                if status.refused_serial != 0 && status.refused_epoch == 0 {
+                    status.refused_epoch = self.#sub_cmd.read().value.epoch;
+                }
                 self.#sub_status.write(status, self.cycle);
                 Ok(())
             })*),
@@ -444,6 +447,8 @@ pub(crate) fn driver_parts(ir: &Ir, names: &Names, ci: usize, part: DriverPart) 
                     state: bk.state(),
                     status: bk.status(),
                     error: bk.error(),
+                    echo_serial: bk.echo_serial(),
+                    refused_serial: bk.refused_serial(),
                     sent: #sent_body,
                     vars: vec![#(#dv::ToValue::to_value(&data.vars.#var_fields)),*],
                     writes: vec![#(#dv::ToValue::to_value(&data.writes.#write_fields)),*],

@@ -4,6 +4,7 @@
 //! The writers then pass the text through rustfmt when it is installed
 //! ([`crate::rustfmt`]); this module stays a pure function of the IR.
 
+mod accept;
 mod builtins;
 mod controller;
 mod driver;

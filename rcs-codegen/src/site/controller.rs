@@ -84,9 +84,17 @@ pub(super) fn controller_page(site: &Site, set: &SetDoc, ci: usize, placed: &Pla
             ),
             None => "—".into(),
         };
+        // Refusal (step 3a) beside the verb's own words.
+        let accept = k.accept.as_ref().map_or_else(String::new, |a| {
+            let p = rcs_dsl::pretty::Printer::new(ir, c, None);
+            format!(
+                "<p>Accepted only when <code>{}</code>; otherwise refused (the sender sees ERROR, REFUSED; the running plan goes on).</p>",
+                esc(&p.expr(&a.cond))
+            )
+        });
         let _ = writeln!(
             body,
-            "<tr id=\"cmd-{}\"><td><b>{}</b></td><td><code>{}</code></td><td>{plan}</td><td>{}</td></tr>",
+            "<tr id=\"cmd-{}\"><td><b>{}</b></td><td><code>{}</code></td><td>{plan}</td><td>{}{accept}</td></tr>",
             esc(&k.name),
             esc(&k.name),
             esc(&params.join(", ")),

@@ -56,7 +56,9 @@ pub mod search;
 pub mod terms;
 mod walk;
 
-use crate::ir::{Condition, Controller, CtrlId, From, Ir, Plan, StateId, StatusId, Type};
+use crate::ir::{
+    Condition, Controller, CtrlId, Expr, ExprKind, From, Ir, Plan, StateId, StatusId, Type,
+};
 use rcs_runtime::driver::Value;
 use search::{Mode, Outcome, Search};
 use std::sync::Arc;
@@ -156,11 +158,29 @@ impl<'ir> PlanAnalysis<'ir> {
         let new_command = terms.intern(Leaf::NewCommand, Type::Bool);
         terms.intern(Leaf::StateCycles, u32_ty.clone());
         terms.intern(Leaf::PlanCycles, u32_ty);
+        // A verb with `accept when A` (step 3a) starts its plan only when A
+        // holds on the arrival cycle: every row the plan can fire then
+        // needs it, so each condition C is read as `C && (!new_command || A)`,
+        // which is exact (a refused command never shows `new_command`).
+        let accept = ctrl.commands[plan.verb.index()].accept.as_ref().map(|a| {
+            let arrival = Expr {
+                kind: ExprKind::NewCommand,
+                ty: Type::Bool,
+                span: a.span,
+            };
+            Formula::Or(vec![
+                Formula::Not(Box::new(terms.made_formula(arrival))),
+                terms.formula(&a.cond),
+            ])
+        });
         let conds = plan
             .rows
             .iter()
             .map(|r| match &r.cond {
-                Condition::When(e) => Some(Arc::new(terms.formula(e))),
+                Condition::When(e) => Some(Arc::new(match &accept {
+                    Some(a) => Formula::And(vec![terms.formula(e), a.clone()]),
+                    None => terms.formula(e),
+                })),
                 Condition::Otherwise => None,
             })
             .collect();

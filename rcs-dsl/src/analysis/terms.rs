@@ -153,6 +153,11 @@ impl<'ir> Terms<'ir> {
         }
     }
 
+    /// A formula of an expression the analysis made (not in the IR).
+    pub fn made_formula(&mut self, e: Expr) -> Formula {
+        Formula::Atom(self.atom(AtomExpr::Made(Box::new(e))))
+    }
+
     fn atom(&mut self, e: AtomExpr<'ir>) -> AtomId {
         if let Some(i) = self.atoms.iter().position(|a| same_expr(&a.expr, &e)) {
             return i;

@@ -128,10 +128,12 @@ pub(super) fn controller_items(
             c.commands
                 .iter()
                 .map(|x| {
-                    (
-                        x.name.clone(),
-                        format!("command {}({})", x.name, params(ir, &x.params)),
-                    )
+                    let mut sig = format!("command {}({})", x.name, params(ir, &x.params));
+                    if let Some(a) = &x.accept {
+                        let p = crate::pretty::Printer::new(ir, c, None);
+                        sig.push_str(&format!(" accept when {}", p.expr(&a.cond)));
+                    }
+                    (x.name.clone(), sig)
                 })
                 .collect()
         }),

@@ -48,6 +48,9 @@ pub(super) fn inline(def: &mut ControllerDef, diags: &mut Diagnostics) {
             EntryKind::Var { init: Some(e), .. } | EntryKind::StatusField { init: Some(e), .. } => {
                 ctx.in_condition(Some(e), diags)
             }
+            EntryKind::Command {
+                accept: Some(a), ..
+            } => ctx.in_condition(Some(&a.cond), diags),
             _ => {}
         }
     }

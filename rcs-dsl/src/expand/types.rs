@@ -355,6 +355,9 @@ fn rename_entry(kind: &mut EntryKind, renames: &BTreeMap<String, Name>) {
             }
         }
         EntryKind::Const(c) => rename_expr(&mut c.value, renames),
+        EntryKind::Command {
+            accept: Some(a), ..
+        } => rename_expr(&mut a.cond, renames),
         EntryKind::Plan(p) => {
             for row in &mut p.rows {
                 if let Some(c) = &mut row.cond {

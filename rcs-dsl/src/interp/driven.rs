@@ -181,6 +181,9 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
             // controller's commands to `sub` (`Driven::write_sub_status`).
             status.echo_epoch = self.interp.sent_epoch(i);
         }
+        if status.refused_serial != 0 && status.refused_epoch == 0 {
+            status.refused_epoch = self.interp.sent_epoch(i);
+        }
         self.interp.write_sub_status(i, status);
         Ok(())
     }
@@ -223,6 +226,8 @@ impl rcs_runtime::driver::Driven for Driven<'_> {
             state: rec.state.0 as u16,
             status: Status(rec.status.0 as u16),
             error: ErrorCode(rec.error.unwrap_or(0)),
+            echo_serial: self.interp.bookkeeping().echo_serial(),
+            refused_serial: self.interp.bookkeeping().refused_serial(),
             sent: rec
                 .sent
                 .into_iter()

@@ -72,7 +72,7 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
         for e in &c.entries {
             let docs = &e.outer.docs;
             match &e.kind {
-                ast::EntryKind::Command(name, params) => {
+                ast::EntryKind::Command { name, params, .. } => {
                     let n = commands.len();
                     if !command_names.claim("command", name, n, |k| commands[k].span, diags) {
                         continue;
@@ -83,6 +83,7 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                         params: lower_params(g, params, diags),
                         plan: None,
                         span: name.span,
+                        accept: None,
                     });
                 }
                 ast::EntryKind::Status(names) => {
@@ -231,6 +232,7 @@ pub(super) fn lower_controller_body(
     let mut diags = Diagnostics::new();
     let diags = &mut diags;
     let mut inits = Vec::new();
+    let mut accepts = Vec::new();
     let mut plans: Vec<Plan> = Vec::new();
     let (mut pre, mut post): (Option<EveryCycle>, Option<EveryCycle>) = (None, None);
     let mut plan_of: Vec<Option<PlanId>> = vec![None; ir.controllers[id.index()].commands.len()];
@@ -260,9 +262,39 @@ pub(super) fn lower_controller_body(
             unresolved_hooks,
             diags,
             plan_verbs: Vec::new(),
+            accept_ctx: false,
         };
         for e in &c.entries {
             match &e.kind {
+                ast::EntryKind::Command {
+                    name,
+                    accept: Some(a),
+                    ..
+                } => {
+                    // The arriving command's parameters, like in its plan.
+                    let Some(ci) = ctrl
+                        .commands
+                        .iter()
+                        .position(|k| k.name == name.text && k.span == name.span)
+                    else {
+                        continue;
+                    };
+                    let cmd = CommandId(ci as u32);
+                    cx.const_ctx = false;
+                    cx.accept_ctx = true;
+                    cx.plan_cmd = Some(cmd);
+                    cx.plan_verbs = vec![cmd];
+                    let cond = cx.check(&a.cond, &Type::Bool);
+                    cx.accept_ctx = false;
+                    cx.plan_verbs.clear();
+                    accepts.push((
+                        ci,
+                        Accept {
+                            cond,
+                            span: a.keyword,
+                        },
+                    ));
+                }
                 ast::EntryKind::Var {
                     name,
                     init: Some(init),
@@ -321,6 +353,7 @@ pub(super) fn lower_controller_body(
     }
     ControllerBody {
         inits,
+        accepts,
         plans,
         plan_of,
         pre,
@@ -335,6 +368,8 @@ pub(super) fn lower_controller_body(
 pub(super) struct ControllerBody {
     /// Each var's initial value, by the var's index.
     inits: Vec<(usize, Expr)>,
+    /// Each `accept when` condition, by its command's index.
+    accepts: Vec<(usize, Accept)>,
     pub(super) plans: Vec<Plan>,
     /// Each command's plan, by the command's index.
     plan_of: Vec<Option<PlanId>>,
@@ -351,6 +386,9 @@ impl ControllerBody {
         }
         for (cmd, p) in ctrl.commands.iter_mut().zip(self.plan_of) {
             cmd.plan = p;
+        }
+        for (ci, a) in self.accepts {
+            ctrl.commands[ci].accept = Some(a);
         }
         ctrl.plans = self.plans;
         ctrl.pre = self.pre;

@@ -102,6 +102,12 @@ pub(super) fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>
             format!("expected {}", one_of(&expected))
         },
     );
+    // `accept if COND`, `accept COND`: the clause is `accept when COND`.
+    if before.ends_with("accept") && expected.iter().any(|w| w == "`when`") {
+        return diagnostic.with_help(
+            "a command is refused unless `accept when COND` holds: write `command VERB(…) accept when COND`",
+        );
+    }
     if spaced_postfix {
         diagnostic.with_help("write calls, fields, indices and `Enum::Variant` without spaces: `h()`, `ship.speed`, `a[0]`")
     } else {
@@ -152,6 +158,7 @@ fn rule_words(rule: Rule) -> Option<&'static str> {
         Rule::index => "`[`",
         Rule::lint_level => "`allow`, `warn` or `deny`",
         Rule::kw_when => "`when`",
+        Rule::kw_accept => "`accept when …`",
         Rule::kw_otherwise => "`otherwise`",
         Rule::kw_as => "`as`",
         Rule::kw_same => "`same`",

@@ -46,6 +46,10 @@ pub(crate) fn err(line: usize, message: impl Into<String>) -> ScenarioError {
 #[derive(Clone, Debug, PartialEq)]
 struct SubSetting {
     status: u16,
+    /// The error code shown with `status: ERROR` (0: none).
+    error: u16,
+    /// `X: REFUSED`: the latest command sent is answered as refused.
+    refused: bool,
     echo: Echo,
     silent: bool,
     /// Status fields the subordinate publishes from this step on, by name.
@@ -69,6 +73,8 @@ struct Expect {
     status: Option<u16>,
     /// `Some(None)`: no error.
     error: Option<Option<u16>>,
+    /// `answered: N`: the serial the answer (status and error) is about.
+    answered: Option<u32>,
     sent: Option<Vec<(CtrlId, CommandId, Vec<Value>)>>,
     /// `vars:` and `status_fields:` (a status field is a var the
     /// controller publishes), by var index.

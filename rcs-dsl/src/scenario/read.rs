@@ -52,6 +52,7 @@ struct RawExpect {
     state: Option<Spanned<String>>,
     status: Option<Spanned<String>>,
     error: Option<Spanned<String>>,
+    answered: Option<Spanned<Json>>,
     sent: Option<Entries>,
     vars: Option<Entries>,
     writes: Option<Entries>,
@@ -393,23 +394,64 @@ impl Resolver<'_> {
                 .map(|i| i as u16)
                 .ok_or_else(|| err(line, format!("`{}` has no status `{name}`", sub.name)))
         };
+        let error_of = |name: &str| {
+            crate::error_codes::code_of(sub, name)
+                .map(|e| e.0)
+                .ok_or_else(|| {
+                    err(
+                        line,
+                        format!(
+                            "`{}` has no error code `{name}`: {}",
+                            sub.name,
+                            error_names(sub)
+                        ),
+                    )
+                })
+        };
+        let refuses = || {
+            if sub.commands.iter().any(|k| k.accept.is_some()) {
+                Ok(())
+            } else {
+                Err(err(
+                    line,
+                    format!(
+                        "`{}` refuses no command (none of its verbs has `accept when`), so it cannot answer REFUSED",
+                        sub.name
+                    ),
+                ))
+            }
+        };
+        let mut s = SubSetting {
+            status: 0,
+            error: 0,
+            refused: false,
+            echo: Echo::Current,
+            silent: false,
+            fields: Vec::new(),
+        };
         match v {
-            Json::String(s) => Ok(SubSetting {
-                status: status_of(s)?,
-                echo: Echo::Current,
-                silent: false,
-                fields: Vec::new(),
-            }),
+            Json::String(r) if r == "REFUSED" => {
+                refuses()?;
+                s.refused = true;
+                Ok(s)
+            }
+            Json::String(n) => {
+                s.status = status_of(n)?;
+                Ok(s)
+            }
             Json::Object(m) => {
-                let mut s = SubSetting {
-                    status: 0,
-                    echo: Echo::Current,
-                    silent: false,
-                    fields: Vec::new(),
-                };
                 for (k, x) in m {
                     match (k.as_str(), x) {
+                        ("status", Json::String(r)) if r == "REFUSED" => {
+                            refuses()?;
+                            s.refused = true;
+                        }
                         ("status", Json::String(n)) => s.status = status_of(n)?,
+                        ("error", Json::String(n)) if n == "REFUSED" => {
+                            refuses()?;
+                            s.refused = true;
+                        }
+                        ("error", Json::String(n)) => s.error = error_of(n)?,
                         ("echo", Json::String(e)) if e == "current" => s.echo = Echo::Current,
                         ("echo", Json::String(e)) if e == "previous" => s.echo = Echo::Previous,
                         ("echo", Json::Number(n)) => {
@@ -421,8 +463,17 @@ impl Resolver<'_> {
                             let v = value(self.ir, line, &f.ty, x, &format!("{}.{k}", sub.name))?;
                             s.fields.push((k.to_string(), v));
                         }
-                        (k, _) => return Err(err(line, format!("bad subordinate setting `{k}`: expected `status: NAME`, `echo: current|previous|N`, `silent: true|false` or a status field of `{}`", sub.name))),
+                        (k, _) => return Err(err(line, format!("bad subordinate setting `{k}`: expected `status: NAME`, `error: CODE`, `echo: current|previous|N`, `silent: true|false` or a status field of `{}`", sub.name))),
                     }
+                }
+                if s.error != 0 && s.status != rcs_runtime::Status::ERROR.0 && !s.refused {
+                    return Err(err(
+                        line,
+                        format!(
+                            "subordinate `{}`: an error code comes with `status: ERROR`",
+                            sub.name
+                        ),
+                    ));
                 }
                 Ok(s)
             }
@@ -497,24 +548,26 @@ impl Resolver<'_> {
             let (line, x) = (line_of(&x), x.value);
             out.error = Some(match x.as_str() {
                 "none" => None,
-                "UNKNOWN_COMMAND" => Some(rcs_runtime::ErrorCode::UNKNOWN_COMMAND.0),
-                "INDEX_RANGE" => Some(rcs_runtime::ErrorCode::INDEX_RANGE.0),
-                "HOOK_PANIC" => Some(rcs_runtime::ErrorCode::HOOK_PANIC.0),
-                name => {
-                    let i = self
-                        .c
-                        .errors
-                        .iter()
-                        .position(|x| x.name == name)
+                name => Some(
+                    crate::error_codes::code_of(self.c, name)
                         .ok_or_else(|| {
                             err(
                                 line,
                                 format!("`{}` has no error code `{name}`", self.c.name),
                             )
-                        })?;
-                    Some(rcs_runtime::ErrorCode::custom(i as u16).0)
-                }
+                        })?
+                        .0,
+                ),
             });
+        }
+        if let Some(a) = e.answered {
+            let line = line_of(&a);
+            out.answered = Some(
+                a.value
+                    .as_u64()
+                    .and_then(|n| u32::try_from(n).ok())
+                    .ok_or_else(|| err(line, "`answered` is a serial (0 to 4294967295)"))?,
+            );
         }
         if e.sent.is_some() {
             let mut list = Vec::new();
@@ -543,4 +596,14 @@ impl Resolver<'_> {
         }
         Ok(out)
     }
+}
+
+/// The error codes of `c` a scenario may name, for a help.
+fn error_names(c: &Controller) -> String {
+    let names: Vec<&str> = crate::error_codes::BUILTIN
+        .iter()
+        .map(|(n, _)| *n)
+        .chain(c.errors.iter().map(|e| e.name.as_str()))
+        .collect();
+    format!("its codes are {}", names.join(", "))
 }

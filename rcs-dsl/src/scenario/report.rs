@@ -45,9 +45,23 @@ pub(super) fn check(
     c: &Controller,
     e: &Expect,
     rec: &Record,
+    latest: u32,
     hooks: StepCalls,
 ) -> Option<String> {
     let mut problems = Vec::new();
+    // What the supervisor sees for its latest command (the handshake view):
+    // a refused command is answered ERROR/REFUSED whatever the plan that
+    // goes on reports.
+    let refused = latest != 0 && rec.refused_serial == latest;
+    let (status, error, answered) = if refused {
+        (
+            rcs_runtime::Status::ERROR,
+            rcs_runtime::ErrorCode::REFUSED,
+            latest,
+        )
+    } else {
+        (rec.status, rec.error, rec.echo_serial)
+    };
     let plan = plan_of(c, rec);
     if let Some(want) = &e.fired {
         let got = rec
@@ -76,7 +90,7 @@ pub(super) fn check(
         }
     }
     if let Some(want) = e.status {
-        if want != rec.status.0 {
+        if want != status.0 {
             let name = |i: u16| {
                 c.statuses
                     .get(usize::from(i))
@@ -86,29 +100,26 @@ pub(super) fn check(
             problems.push(format!(
                 "status: expected {}, got {}",
                 name(want),
-                name(rec.status.0)
+                name(status.0)
             ));
         }
     }
     if let Some(want) = &e.error {
-        let got = (!rec.error.is_none()).then_some(rec.error.0);
+        let got = (!error.is_none()).then_some(error.0);
         if *want != got {
-            let name = |x: Option<u16>| match x {
-                None => "none".to_string(),
-                Some(1) => "UNKNOWN_COMMAND".to_string(),
-                Some(n) if n == rcs_runtime::ErrorCode::INDEX_RANGE.0 => "INDEX_RANGE".to_string(),
-                Some(n) if n == rcs_runtime::ErrorCode::HOOK_PANIC.0 => "HOOK_PANIC".to_string(),
-                Some(n) => c
-                    .errors
-                    .get(usize::from(n).wrapping_sub(2))
-                    .map(|e| e.name.clone())
-                    .unwrap_or_else(|| n.to_string()),
+            let name = |x: Option<u16>| {
+                crate::error_codes::name_of(c, rcs_runtime::ErrorCode(x.unwrap_or(0)))
             };
             problems.push(format!(
                 "error: expected {}, got {}",
                 name(*want),
                 name(got)
             ));
+        }
+    }
+    if let Some(want) = e.answered {
+        if want != answered {
+            problems.push(format!("answered: expected serial {want}, got {answered}"));
         }
     }
     if let Some(want) = &e.sent {

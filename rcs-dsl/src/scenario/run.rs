@@ -92,6 +92,8 @@ fn drive(
         .map(|_| Sub {
             setting: SubSetting {
                 status: 0,
+                error: 0,
+                refused: false,
                 echo: Echo::Literal(0),
                 silent: false,
                 fields: Vec::new(),
@@ -102,11 +104,14 @@ fn drive(
         .collect();
     let mut hook_calls = vec![0u64; c.hooks.len()];
     let mut hook_args: Vec<(u16, Vec<Value>)> = Vec::new();
+    // The serial of the latest command the scenario sent (0: none).
+    let mut latest = 0u32;
     for (k, step) in std::iter::once(&s.initial).chain(&s.steps).enumerate() {
         let line = step.line;
         let fail = |e: DriveError| (line, e.to_string());
         if let Some((cmd, args)) = &step.command {
-            d.command(&c.commands[cmd.index()].name, args)
+            latest = d
+                .command(&c.commands[cmd.index()].name, args)
                 .map_err(fail)?;
         }
         for (i, v) in &step.reads {
@@ -174,10 +179,22 @@ fn drive(
                     (_, Echo::Previous) => d.last_sent(sub_name(i)).map_err(fail)?.wrapping_sub(1),
                 };
                 sub.shown = echo;
-                let status = StatusBuffer {
-                    echo_serial: echo,
-                    status: Status(sub.setting.status),
-                    ..StatusBuffer::default()
+                let status = if sub.setting.refused {
+                    // Refused: the echo stays on the command before, whose
+                    // plan goes on; the refusal names the latest.
+                    StatusBuffer {
+                        echo_serial: echo.wrapping_sub(1),
+                        status: Status::EXECUTING,
+                        refused_serial: echo,
+                        ..StatusBuffer::default()
+                    }
+                } else {
+                    StatusBuffer {
+                        echo_serial: echo,
+                        status: Status(sub.setting.status),
+                        error: rcs_runtime::ErrorCode(sub.setting.error),
+                        ..StatusBuffer::default()
+                    }
                 };
                 d.write_sub_status(sub_name(i), status).map_err(fail)?;
             }
@@ -199,7 +216,7 @@ fn drive(
         let Some(rec) = last else {
             return Err((line, "the step ran no cycle".to_string()));
         };
-        if let Some(report) = check(ir, c, &step.expect, &rec, (&hook_calls, &hook_args)) {
+        if let Some(report) = check(ir, c, &step.expect, &rec, latest, (&hook_calls, &hook_args)) {
             return Err((line, report));
         }
     }

@@ -21,6 +21,7 @@ fn stamped_in(epoch: u32, echo: u32, status: Status, generation: u64) -> Stamped
             },
             verb: 0,
             state: 0,
+            ..Default::default()
         },
         generation,
         writer_cycle: generation,
@@ -239,6 +240,7 @@ fn status_ranges() {
         error: ErrorCode::custom(2),
         verb: 1,
         state: 4,
+        ..Default::default()
     };
     assert_eq!(ok.check_range(2, 3, 2, 5), Ok(()));
     let bad = |f: fn(&mut StatusBuffer)| {
@@ -259,4 +261,40 @@ fn status_ranges() {
     assert_eq!(bad(|s| s.state = 5), Err("state"));
     // The zeroed buffer of a controller that has no verbs yet.
     assert_eq!(StatusBuffer::default().check_range(0, 0, 0, 0), Ok(()));
+}
+
+#[test]
+fn a_refusal_answers_only_the_command_it_names() {
+    let mut l = SubordinateLink::with_epoch(E);
+    let s1 = l.next_command();
+    let mut read = stamped(s1, Status::EXECUTING, 1);
+    assert_eq!(l.observe(&read).status, Status::EXECUTING);
+    let s2 = l.next_command();
+    // X refuses s2 and its plan for s1 goes on, then completes: DONE for s1.
+    read.value.refused_serial = s2;
+    read.value.refused_epoch = E;
+    read.generation = 2;
+    let v = l.observe(&read);
+    assert_eq!((v.status, v.error), (Status::ERROR, ErrorCode::REFUSED));
+    read.value.status = Status::DONE;
+    read.generation = 3;
+    let v = l.observe(&read);
+    assert_eq!(
+        (v.status, v.error),
+        (Status::ERROR, ErrorCode::REFUSED),
+        "the running plan's DONE never answers the refused command"
+    );
+    // A refusal of another epoch (another incarnation) is not ours.
+    read.value.refused_epoch = E + 1;
+    read.generation = 4;
+    assert_eq!(l.observe(&read).status, Status::EXECUTING);
+    // Sending again ends it: the old refusal names s2, not s3.
+    read.value.refused_epoch = E;
+    let s3 = l.next_command();
+    read.generation = 5;
+    assert_eq!(l.observe(&read).status, Status::EXECUTING);
+    read.value.echo_serial = s3;
+    read.generation = 6;
+    assert_eq!(l.observe(&read).status, Status::DONE);
+    assert!(ErrorCode::REFUSED.is_builtin());
 }

@@ -33,7 +33,8 @@ fn new_command_resets_and_starts_in_s0() {
             status: Status::EXECUTING,
             error: ErrorCode::NONE,
             verb: MOVE,
-            state: S0
+            state: S0,
+            ..Default::default()
         }
     );
     assert!(bk.fire(0, Target::State(1)));
@@ -250,4 +251,96 @@ fn sample_stats() {
         s.record(v);
     }
     assert_eq!((s.count, s.last, s.min, s.max, s.mean()), (3, 9, 1, 9, 5));
+}
+
+#[test]
+fn a_refused_command_puts_the_running_plan_back_and_is_not_new_again() {
+    let mut bk = Bookkeeping::new(2);
+    bk.begin_cycle_raw(tick(0), 1, 9, MOVE, true);
+    bk.fire(0, Target::State(2));
+    bk.report(Status::custom(0));
+    bk.end_cycle();
+    bk.begin_cycle_raw(tick(1), 1, 9, MOVE, true);
+    bk.end_cycle();
+    let running = (
+        bk.verb(),
+        bk.state(),
+        bk.status(),
+        bk.state_cycles(),
+        bk.plan_cycles(),
+    );
+    assert_eq!(running, (MOVE, 2, Status::custom(0), 2, 2));
+
+    // Serial 2 (INIT) arrives and is refused.
+    assert_eq!(
+        bk.begin_cycle_raw(tick(2), 2, 9, INIT, true),
+        NewCommand::Started
+    );
+    assert_eq!((bk.verb(), bk.state_cycles()), (INIT, 0));
+    bk.refuse();
+    assert!(!bk.new_command() && bk.is_active());
+    assert_eq!(
+        (
+            bk.verb(),
+            bk.state(),
+            bk.status(),
+            bk.state_cycles(),
+            bk.plan_cycles()
+        ),
+        running
+    );
+    let sb = bk.status_buffer();
+    assert_eq!(
+        (sb.echo_serial, sb.echo_epoch),
+        (1, 9),
+        "the echo stays on the running command"
+    );
+    assert_eq!((sb.refused_serial, sb.refused_epoch), (2, 9));
+    assert_eq!(bk.verb_stats()[usize::from(MOVE)].superseded, 0);
+    bk.end_cycle();
+
+    // The refused command stays in the buffer: not new on later cycles.
+    assert_eq!(
+        bk.begin_cycle_raw(tick(3), 2, 9, INIT, true),
+        NewCommand::No
+    );
+    assert_eq!(bk.plan_cycles(), 3, "the running plan's counters go on");
+    bk.end_cycle();
+    // The next one is new, and nothing was lost between them.
+    assert_eq!(
+        bk.begin_cycle_raw(tick(4), 3, 9, INIT, true),
+        NewCommand::Started
+    );
+    assert_eq!(bk.commands_lost(), 0);
+    assert_eq!(
+        bk.status_buffer().refused_serial,
+        2,
+        "the refusal names serial 2 still"
+    );
+    assert_eq!(bk.verb_stats()[usize::from(MOVE)].superseded, 1);
+}
+
+#[test]
+fn refuse_without_a_new_command_does_nothing() {
+    let mut bk = Bookkeeping::new(2);
+    bk.begin_cycle_raw(tick(0), 1, 9, MOVE, true);
+    bk.end_cycle();
+    bk.begin_cycle_raw(tick(1), 1, 9, MOVE, true);
+    let before = bk.status_buffer();
+    bk.refuse();
+    assert_eq!(bk.status_buffer(), before);
+    assert_eq!(bk.refused_serial(), 0);
+}
+
+#[test]
+fn a_refusal_before_any_command_keeps_not_ready() {
+    let mut bk = Bookkeeping::new(2);
+    bk.begin_cycle_raw(tick(0), 1, 9, MOVE, true);
+    bk.refuse();
+    let sb = bk.status_buffer();
+    assert_eq!(
+        (sb.echo_serial, sb.status, sb.refused_serial),
+        (0, Status::NOT_READY, 1)
+    );
+    assert!(!bk.is_active() && !bk.finished());
 }

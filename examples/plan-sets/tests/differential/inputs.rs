@@ -26,6 +26,8 @@ pub(crate) struct Answer {
     pub(crate) echo: Echo,
     pub(crate) status: u16,
     pub(crate) error: u16,
+    /// The answered serial is refused (the echo stays one before it).
+    pub(crate) refused: bool,
     /// The subordinate's status fields (`status NAME: TYPE`), in order.
     pub(crate) fields: Vec<Value>,
 }
@@ -365,36 +367,44 @@ impl<'a> Values<'a> {
             .iter()
             .map(|h| proptest::option::weighted(0.3, self.of(&h.ret)))
             .collect();
-        let subs: Vec<_> =
-            c.subordinates
-                .iter()
-                .map(|s| {
-                    let sub = ir.controller(*s);
-                    let statuses = sub.statuses.len() as u16;
-                    let errors = sub.errors.len() as u16 + ErrorCode::FIRST_CUSTOM;
-                    let echo = prop_oneof![
-                        6 => Just(Echo::Last),
-                        2 => (1u32..3).prop_map(Echo::Older),
-                        1 => any::<u32>().prop_map(Echo::Any),
-                    ];
-                    let status = prop_oneof![
-                        3 => Just(Status::DONE.0),
-                        2 => Just(Status::ERROR.0),
-                        2 => Just(Status::EXECUTING.0),
-                        2 => 0..statuses,
-                    ];
-                    let fields: Vec<_> = sub.status_fields().map(|(_, v)| self.of(&v.ty)).collect();
-                    let answer = (echo, status, 0..errors, fields).prop_map(
-                        |(echo, status, error, fields)| Answer {
-                            echo,
-                            status,
-                            error,
-                            fields,
-                        },
-                    );
-                    proptest::option::weighted(0.4, answer)
-                })
-                .collect();
+        let subs: Vec<_> = c
+            .subordinates
+            .iter()
+            .map(|s| {
+                let sub = ir.controller(*s);
+                let statuses = sub.statuses.len() as u16;
+                let errors = sub.errors.len() as u16 + ErrorCode::FIRST_CUSTOM;
+                let echo = prop_oneof![
+                    6 => Just(Echo::Last),
+                    2 => (1u32..3).prop_map(Echo::Older),
+                    1 => any::<u32>().prop_map(Echo::Any),
+                ];
+                let status = prop_oneof![
+                    3 => Just(Status::DONE.0),
+                    2 => Just(Status::ERROR.0),
+                    2 => Just(Status::EXECUTING.0),
+                    2 => 0..statuses,
+                ];
+                let fields: Vec<_> = sub.status_fields().map(|(_, v)| self.of(&v.ty)).collect();
+                // A subordinate that can refuse (`accept when`) now
+                // and then refuses the command it answers.
+                let refused = if sub.commands.iter().any(|k| k.accept.is_some()) {
+                    proptest::bool::weighted(0.2).boxed()
+                } else {
+                    Just(false).boxed()
+                };
+                let answer = (echo, status, 0..errors, fields, refused).prop_map(
+                    |(echo, status, error, fields, refused)| Answer {
+                        echo,
+                        status,
+                        error,
+                        fields,
+                        refused,
+                    },
+                );
+                proptest::option::weighted(0.4, answer)
+            })
+            .collect();
         let cycles = prop_oneof![98 => Just(1u32), 2 => 50u32..=300];
         let step = (command, bad, updates, hooks, subs, all_done, cycles).prop_map(
             |(command, bad, reads, hooks, subs, all_done, cycles)| Step {

@@ -289,11 +289,20 @@ pub(crate) fn run_sequence(
                     Echo::Older(k) => last.wrapping_sub(k),
                     Echo::Any(x) => x,
                 };
-                let status = StatusBuffer {
-                    echo_serial,
-                    status: Status(a.status),
-                    error: ErrorCode(a.error),
-                    ..StatusBuffer::default()
+                let status = if a.refused {
+                    StatusBuffer {
+                        echo_serial: echo_serial.wrapping_sub(1),
+                        status: Status(a.status),
+                        refused_serial: echo_serial,
+                        ..StatusBuffer::default()
+                    }
+                } else {
+                    StatusBuffer {
+                        echo_serial,
+                        status: Status(a.status),
+                        error: ErrorCode(a.error),
+                        ..StatusBuffer::default()
+                    }
                 };
                 p.ok(Call::WriteSubStatus(name, status))?;
                 let sub = ir.controller(*s);

@@ -53,6 +53,8 @@ pub(in crate::lower) struct Cx<'a, 'g> {
     pub(in crate::lower) diags: &'a mut Diagnostics,
     /// Inside a plan: all its verbs (`plan A | B`), for `X <- cmd`.
     pub(in crate::lower) plan_verbs: Vec<CommandId>,
+    /// In an `accept when` condition: no hook calls, no plan quantities.
+    pub(in crate::lower) accept_ctx: bool,
 }
 
 /// A lowered array index.
@@ -72,6 +74,25 @@ pub(in crate::lower) fn err_expr(span: Span) -> Expr {
 }
 
 impl Cx<'_, '_> {
+    /// `what` written in an `accept when` condition, which may not have it.
+    pub(in crate::lower) fn not_in_accept(
+        &mut self,
+        span: Span,
+        what: &str,
+        help: &str,
+    ) -> (Expr, Ty) {
+        self.diags.push(
+            Diagnostic::error(
+                Code::AcceptCondition,
+                format!("{what} in an `accept when` condition"),
+                span,
+                "not allowed in `accept when`",
+            )
+            .with_help(help.to_string()),
+        );
+        (err_expr(span), Ty::Err)
+    }
+
     pub(in crate::lower) fn type_name(&self, t: &Type) -> String {
         type_name(self.ir, t)
     }
@@ -250,6 +271,13 @@ impl Cx<'_, '_> {
             ast::ExprKind::NewCommand | ast::ExprKind::StateCycles | ast::ExprKind::PlanCycles => {
                 if self.const_ctx {
                     return self.not_const(span, "a plan quantity");
+                }
+                if self.accept_ctx {
+                    return self.not_in_accept(
+                        span,
+                        "a plan quantity",
+                        "the condition is judged before the command replaces the running plan, so `new_command`, `state_cycles` and `plan_cycles` would be the arriving command's; keep what the condition needs in a var of the running plan (`var may_hold: bool`, set in its rows) and write `accept when may_hold`",
+                    );
                 }
                 let (kind, ty) = match &e.kind {
                     ast::ExprKind::NewCommand => (ExprKind::NewCommand, Type::Bool),

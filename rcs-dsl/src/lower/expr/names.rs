@@ -289,6 +289,13 @@ impl Cx<'_, '_> {
         if self.const_ctx {
             return self.not_const(span, "a hook call");
         }
+        if self.accept_ctx {
+            return self.not_in_accept(
+                span,
+                "a hook call",
+                "the condition decides whether a command is taken and must not act on the world; call the hook in `pre` into a var (`pre { ready = drive_ready() }`) and write `accept when ready`",
+            );
+        }
         let hook = match self.value(&name.text) {
             Some(Value::Hook(h)) => h,
             _ => {

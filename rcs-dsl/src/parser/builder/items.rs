@@ -249,7 +249,25 @@ impl Builder {
             }
             Rule::command_decl => {
                 let name = self.name(inner.next()?);
-                EntryKind::Command(name, self.params(inner))
+                let rest: Vec<_> = inner.collect();
+                let accept = rest
+                    .iter()
+                    .find(|p| p.as_rule() == Rule::accept_clause)
+                    .and_then(|a| {
+                        let mut parts = a.clone().into_inner();
+                        let kw = self.span(&parts.next()?);
+                        let when = self.span(&parts.next()?);
+                        let cond = self.expr(parts.next()?);
+                        Some(crate::ast::Accept {
+                            keyword: kw.to(when),
+                            cond,
+                        })
+                    });
+                EntryKind::Command {
+                    name,
+                    params: self.params(rest.into_iter()),
+                    accept,
+                }
             }
             Rule::status_field_decl => {
                 let name = self.name(inner.next()?);

@@ -177,7 +177,7 @@ pub(crate) fn to_node(p: &Printer, r: &Row, from: &str) -> String {
         Target::Same => from.to_string(),
         Target::State(_) => p.target(r),
         Target::Done => "Done".to_string(),
-        Target::Error(_) => "Error".to_string(),
+        Target::Error(_) | Target::ErrorOf(_) => "Error".to_string(),
     }
 }
 

@@ -140,7 +140,7 @@ pub fn controller_tables(ir: &Ir, ctrl: &Controller) -> String {
             let mut jobs: Vec<String> = jobs.iter().map(|j| code(j)).collect();
             match r.to {
                 Target::Done => jobs.push("status DONE".to_string()),
-                Target::Error(_) => jobs.push("status ERROR".to_string()),
+                Target::Error(_) | Target::ErrorOf(_) => jobs.push("status ERROR".to_string()),
                 _ => {}
             }
             let _ = write!(

@@ -330,8 +330,17 @@ impl<'ir> Interpreter<'ir> {
             Target::Done => rcs_runtime::Target::Done,
             Target::Error(None) => rcs_runtime::Target::Error(ErrorCode::NONE),
             Target::Error(Some(e)) => rcs_runtime::Target::Error(ErrorCode::custom(e.0 as u16)),
+            Target::ErrorOf(v) => rcs_runtime::Target::Error(error_code(&self.vars[v.index()])),
         };
         self.bk.fire(row.position as u16, target);
+    }
+}
+
+/// The error code a value of type `error` holds (a var, a status field).
+pub(crate) fn error_code(v: &Value) -> ErrorCode {
+    match v {
+        Value::Int(n) => ErrorCode(u16::try_from(*n).unwrap_or(0)),
+        _ => ErrorCode::NONE,
     }
 }
 

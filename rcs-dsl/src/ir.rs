@@ -223,6 +223,9 @@ pub enum Type {
     Array(Box<Type>, u32),
     /// The status of a controller (built-ins plus its custom statuses).
     Status(CtrlId),
+    /// An error code of a controller (built-ins plus the codes it
+    /// declares): the type `error`, and `X.error_code` (§8).
+    ErrorCode(CtrlId),
     /// What a hook without a return type gives.
     Unit,
 }
@@ -572,6 +575,9 @@ pub enum Target {
     Same,
     Done,
     Error(Option<ErrorId>),
+    /// `-> Error(v)`: the code held by var (or status field) `v`, of type
+    /// `error`.
+    ErrorOf(VarId),
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -597,6 +603,9 @@ pub enum Job {
         /// and for a bare `report ERROR`).
         #[serde(skip_serializing_if = "Option::is_none")]
         error: Option<ErrorId>,
+        /// `report ERROR(v)`: the code held by var `v`, of type `error`.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        error_of: Option<VarId>,
     },
     /// A hook called for its effect; `call` is an `ExprKind::Call`.
     Call(Expr),
@@ -673,6 +682,10 @@ pub enum ExprKind {
     Variant(EnumId, u32),
     /// A status of the controller given by the expression's type.
     Status(StatusId),
+    /// An error code (the runtime's number: a built-in or a declared one)
+    /// of the controller given by the expression's type (`FAULTED` beside
+    /// `X.error_code`, or in a var of type `error`).
+    ErrorCode(u16),
     NewCommand,
     StateCycles,
     PlanCycles,
@@ -715,6 +728,9 @@ pub enum SubProp {
     Executing,
     Error,
     StaleCycles,
+    /// `X.error_code`: the code of X's ERROR answer to the latest command
+    /// (0, no error, otherwise).
+    ErrorCode,
 }
 
 impl SubProp {
@@ -725,6 +741,7 @@ impl SubProp {
             SubProp::Executing => "executing",
             SubProp::Error => "error",
             SubProp::StaleCycles => "stale_cycles",
+            SubProp::ErrorCode => "error_code",
         }
     }
 }

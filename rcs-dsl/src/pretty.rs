@@ -58,6 +58,16 @@ impl<'a> Printer<'a> {
                 };
                 out.push_str(&owner.statuses[s.index()].name);
             }
+            ExprKind::ErrorCode(code) => {
+                let owner = match e.ty {
+                    Type::ErrorCode(c) => &self.ir.controllers[c.index()],
+                    _ => self.ctrl,
+                };
+                out.push_str(&crate::error_codes::name_of(
+                    owner,
+                    rcs_runtime::ErrorCode(*code),
+                ));
+            }
             ExprKind::NewCommand => out.push_str("new_command"),
             ExprKind::StateCycles => out.push_str("state_cycles"),
             ExprKind::PlanCycles => out.push_str("plan_cycles"),
@@ -228,6 +238,17 @@ impl<'a> Printer<'a> {
                     self.ctrl.errors[code.index()].name
                 )
             }
+            Job::Report {
+                status,
+                error_of: Some(v),
+                ..
+            } => {
+                format!(
+                    "report {}({})",
+                    self.ctrl.statuses[status.index()].name,
+                    self.ctrl.vars[v.index()].name
+                )
+            }
             Job::Report { status, .. } => {
                 format!("report {}", self.ctrl.statuses[status.index()].name)
             }
@@ -275,6 +296,7 @@ impl<'a> Printer<'a> {
             Target::Done => "Done".to_string(),
             Target::Error(None) => "Error".to_string(),
             Target::Error(Some(e)) => format!("Error({})", self.ctrl.errors[e.index()].name),
+            Target::ErrorOf(v) => format!("Error({})", self.ctrl.vars[v.index()].name),
         }
     }
 

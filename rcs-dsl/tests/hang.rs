@@ -96,6 +96,14 @@ fn random_value(ir: &Ir, t: &Type, rng: &mut TestRng) -> Value {
         Type::Status(c) => {
             Value::Status(rng.random_range(0..ir.controller(*c).statuses.len() as u16))
         }
+        // No error or one of the declared codes.
+        Type::ErrorCode(c) => {
+            let n = ir.controller(*c).errors.len() as i128;
+            match rng.random_range(0..=n) {
+                0 => Value::Int(0),
+                k => Value::Int(k + 1),
+            }
+        }
         Type::Unit => Value::Unit,
     }
 }

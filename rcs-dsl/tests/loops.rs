@@ -110,7 +110,9 @@ impl<'ir> Rig<'ir> {
                 // `stale_cycles` is 0: every subordinate writes each cycle.
                 Leaf::SubStale(_) => assert_eq!(*v, Value::Int(0)),
                 Leaf::Var(..) => {} // vars no job assigns: their initial value
-                Leaf::SubField(..) => unreachable!("the generated plans read no status field"),
+                Leaf::SubField(..) | Leaf::SubErrorCode(_) => {
+                    unreachable!("the generated plans read no status field nor error code")
+                }
             }
         }
     }

@@ -91,7 +91,9 @@ fn rows_fire(ir: &Ir, case: &str, counts: &mut Counts) {
                         Target::State(t) => p.states[t.index()].name.clone(),
                         Target::Same => p.states[s].name.clone(),
                         // The plan ends: the record keeps the state it was in.
-                        Target::Done | Target::Error(_) => p.states[s].name.clone(),
+                        Target::Done | Target::Error(_) | Target::ErrorOf(_) => {
+                            p.states[s].name.clone()
+                        }
                     };
                     let expect = Expect::Fires {
                         row: rcs_dsl::analysis::run::row_name(row),

@@ -135,6 +135,22 @@ impl FromValue for Status {
     }
 }
 
+/// An error code travels as its number (`rcs_dsl` gives it the name).
+impl ToValue for ErrorCode {
+    fn to_value(&self) -> Value {
+        Value::Int(i128::from(self.0))
+    }
+}
+
+impl FromValue for ErrorCode {
+    fn from_value(v: &Value) -> Option<Self> {
+        match v {
+            Value::Int(n) => u16::try_from(*n).ok().map(ErrorCode),
+            _ => None,
+        }
+    }
+}
+
 impl ToValue for () {
     fn to_value(&self) -> Value {
         Value::Unit

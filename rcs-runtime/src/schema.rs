@@ -10,7 +10,7 @@
 //! types theirs. Hashes are FNV-1a (64 bit): deterministic across builds,
 //! machines and compiler versions, unlike `std::hash`.
 
-use crate::handshake::{CommandBuffer, StatusBuffer};
+use crate::handshake::{CommandBuffer, ErrorCode, Status, StatusBuffer};
 
 /// A type with a stable structural fingerprint.
 pub trait Schema {
@@ -63,6 +63,14 @@ impl Schema for StatusBuffer {
         "StatusBuffer{echo_serial:u32,echo_epoch:u32,status:u16,error:u16,verb:u16,state:u16,refused_serial:u32,refused_epoch:u32}",
         &[],
     );
+}
+
+impl Schema for ErrorCode {
+    const SCHEMA: u64 = combine("ErrorCode(u16)", &[]);
+}
+
+impl Schema for Status {
+    const SCHEMA: u64 = combine("Status(u16)", &[]);
 }
 
 impl<C: Schema> Schema for CommandBuffer<C> {

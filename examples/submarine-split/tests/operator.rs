@@ -1,7 +1,10 @@
 //! The operator in a process of its own: `Operators::remote` commands SM,
 //! which runs in the helm, through the access control (the `operator`
 //! certificate), and sees SM's status come back. A process certificate
-//! (the engine's) cannot command the root the same way.
+//! (the engine's) cannot command the root the same way. SM refuses an order
+//! beyond the hull's top speed (`accept when`): across the processes the
+//! operator sees ERROR / REFUSED for that order until it sends another,
+//! while SM's transit under way goes on and is not taken as the answer.
 //!
 //! Every wait has a generous deadline; nothing asserts on timing.
 
@@ -11,7 +14,7 @@ use std::net::TcpListener;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use rcs_runtime::{BridgeConfig, TlsFiles};
+use rcs_runtime::{BridgeConfig, ErrorCode, Status, TlsFiles};
 
 mod common;
 use common::{endpoint, security_args, Proc};
@@ -69,6 +72,56 @@ fn operator_commands_a_root_in_another_process() {
         let speed = helm.reports(1, "speed")[0];
         (speed == 7 || speed == 8).then_some(())
     });
+    assert!(bridge.errors().is_empty(), "{:?}", bridge.errors());
+}
+
+#[test]
+fn a_root_in_another_process_refuses_an_order_and_its_transit_goes_on() {
+    let (mut helm, _engine, ep, certs) = hierarchy();
+    let config = BridgeConfig::new("submarine_split", "operator")
+        .certs(&certs)
+        .connect(&ep);
+    let (mut ops, bridge) = Operators::remote(config).expect("the operator's bridge");
+    until("the helm as a peer", || (bridge.peers() > 0).then_some(()));
+    let slow = ops.sm.command(sm::Command::Transit { speed: 8.0 });
+    until("SM's echo of the 8 kn order", || {
+        (ops.sm.status().value.echo_serial == slow).then_some(())
+    });
+    // 40 kn is beyond MAX_KNOTS: refused in the helm, seen here.
+    let fast = ops.sm.command(sm::Command::Transit { speed: 40.0 });
+    until("the refusal", || {
+        let v = ops.sm.view();
+        (v.error == ErrorCode::REFUSED).then_some(())
+    });
+    let refused = |ops: &mut Operators| {
+        let v = ops.sm.view();
+        let raw = ops.sm.status().value;
+        assert_eq!(
+            (v.status, v.error),
+            (Status::ERROR, ErrorCode::REFUSED),
+            "the refusal shows until the operator sends again: {raw:?}"
+        );
+        assert_eq!((raw.refused_serial, raw.echo_serial), (fast, slow));
+        raw
+    };
+    // The 8 kn transit goes on: the ship slows to 8 kn and SM's plan for
+    // it reaches S2 (PR at its goal), all of it reported for the older
+    // order, none of it taken as the answer to the refused one.
+    until("the ship at 8 kn under the refusal", || {
+        refused(&mut ops);
+        let speed = helm.reports(1, "speed")[0];
+        (speed == 7 || speed == 8).then_some(())
+    });
+    until("SM's 8 kn transit at its goal (S2)", || {
+        let raw = refused(&mut ops);
+        (sm::state_name(raw.verb, raw.state) == Some("S2")).then_some(())
+    });
+    // Sending again ends the refusal.
+    let again = ops.sm.command(sm::Command::Transit { speed: 10.0 });
+    until("SM's echo of the 10 kn order", || {
+        (ops.sm.status().value.echo_serial == again).then_some(())
+    });
+    assert_ne!(ops.sm.view().error, ErrorCode::REFUSED);
     assert!(bridge.errors().is_empty(), "{:?}", bridge.errors());
 }
 

@@ -354,7 +354,7 @@ fn type_bound(ir: &Ir, ty: &Type) -> u64 {
     match ty {
         Type::Bool | Type::Unit => 1,
         Type::Int(_) | Type::Float(_) => 10,
-        Type::Enum(_) | Type::Status(_) => 5,
+        Type::Enum(_) | Type::Status(_) | Type::ErrorCode(_) => 5,
         Type::Buffer(b) => ir.buffer_types[b.index()]
             .fields
             .iter()

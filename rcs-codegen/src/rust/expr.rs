@@ -171,6 +171,7 @@ pub(crate) fn rust_type(names: &Names, t: &Type) -> TokenStream {
             quote!([#elem; #n])
         }
         Type::Status(_) => quote!(rt::Status),
+        Type::ErrorCode(_) => quote!(rt::ErrorCode),
         Type::Unit => quote!(()),
     }
 }
@@ -191,6 +192,7 @@ pub(crate) fn zero(names: &Names, t: &Type) -> TokenStream {
             quote!([#z; #n])
         }
         Type::Status(_) => quote!(rt::Status::NOT_READY),
+        Type::ErrorCode(_) => quote!(rt::ErrorCode::NONE),
         Type::Unit => quote!(()),
     }
 }
@@ -272,6 +274,12 @@ impl Gen<'_> {
                 let c = &self.names.ctrls[owner.index()].status_consts[s.index()];
                 Code::atom(quote!(super::#module::status::#c))
             }
+            // An error code by its runtime number (the owner's `error::NAME`
+            // holds the same; a built-in has no constant in every module).
+            ExprKind::ErrorCode(code) => {
+                let raw = proc_macro2::Literal::u16_suffixed(*code);
+                Code::atom(quote!(rt::ErrorCode(#raw)))
+            }
             ExprKind::NewCommand => Code::atom(quote!(self.bk.new_command())),
             ExprKind::StateCycles => Code::atom(quote!(self.bk.state_cycles())),
             ExprKind::PlanCycles => Code::atom(quote!(self.bk.plan_cycles())),
@@ -346,6 +354,7 @@ impl Gen<'_> {
                     SubProp::Executing => quote!(subs.#id.executing()),
                     SubProp::Error => quote!(subs.#id.error()),
                     SubProp::StaleCycles => quote!(subs.#id.stale_cycles),
+                    SubProp::ErrorCode => quote!(subs.#id.error),
                 })
             }
             ExprKind::SubField(sub, var) => Code::atom(super::every_cycle::sub_field(
@@ -654,6 +663,12 @@ impl Gen<'_> {
             } => {
                 let c = &self.cn().error_consts[code.index()];
                 quote!(self.bk.report_error(error::#c);)
+            }
+            Job::Report {
+                error_of: Some(v), ..
+            } => {
+                let id = &self.cn().vars[v.index()];
+                quote!(self.bk.report_error(self.data.vars.#id);)
             }
             Job::Report { status, .. } => {
                 let c = &self.cn().status_consts[status.index()];

@@ -379,14 +379,16 @@ impl Cmp<'_> {
                 Job::Report {
                     status: s,
                     error: e,
+                    error_of: v,
                     ..
                 },
                 Job::Report {
                     status: t,
                     error: f,
+                    error_of: w,
                     ..
                 },
-            ) => s == t && e == f,
+            ) => s == t && e == f && v == w,
             (Job::Call(p), Job::Call(q)) => self.expr(p, q),
             _ => false,
         }

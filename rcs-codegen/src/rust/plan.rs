@@ -143,6 +143,10 @@ pub(super) fn plan_fn(
                 let id = &n.error_consts[e.index()];
                 quote!(rt::Target::Error(error::#id))
             }
+            Target::ErrorOf(v) => {
+                let id = &n.vars[v.index()];
+                quote!(rt::Target::Error(self.data.vars.#id))
+            }
         };
         let body = quote! {
             #(#doc_markers)*

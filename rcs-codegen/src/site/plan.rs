@@ -162,7 +162,7 @@ fn states(
     for terminal in ["Done", "Error"] {
         let reached = plan.rows.iter().any(|r| match r.to {
             Target::Done => terminal == "Done",
-            Target::Error(_) => terminal == "Error",
+            Target::Error(_) | Target::ErrorOf(_) => terminal == "Error",
             _ => false,
         });
         if reached {
@@ -238,7 +238,7 @@ fn rows(
             .collect();
         match r.to {
             Target::Done => jobs.push("status DONE".into()),
-            Target::Error(_) => jobs.push("status ERROR".into()),
+            Target::Error(_) | Target::ErrorOf(_) => jobs.push("status ERROR".into()),
             _ => {}
         }
         // Each state named links to its entry in the list of states.

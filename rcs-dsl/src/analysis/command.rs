@@ -471,7 +471,10 @@ impl PlanAnalysis<'_> {
                 unsure |= match &self.terms.leaves[l].0 {
                     Leaf::Var(..) => !given.iter().any(|(g, _)| *g == l),
                     Leaf::Buffer(b, _) => self.ctrl.writes.contains(b),
-                    Leaf::StateCycles | Leaf::PlanCycles | Leaf::SubStale(_) => true,
+                    Leaf::StateCycles
+                    | Leaf::PlanCycles
+                    | Leaf::SubStale(_)
+                    | Leaf::SubErrorCode(_) => true,
                     Leaf::NewCommand
                     | Leaf::Param(..)
                     | Leaf::Call(..)
@@ -501,7 +504,7 @@ fn target_node(node: usize, n: usize, to: Target) -> Option<usize> {
         Target::State(s) => s.index(),
         // `same` on the first cycle: S0 again, on a later cycle.
         Target::Same if node == 0 => n,
-        Target::Same | Target::Done | Target::Error(_) => return None,
+        Target::Same | Target::Done | Target::Error(_) | Target::ErrorOf(_) => return None,
     };
     (to != node).then_some(to)
 }

@@ -208,7 +208,7 @@ pub fn command_storms(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<
             let stays = match r.to {
                 Target::Same => true,
                 Target::State(t) => covers(&r.from, t),
-                Target::Done | Target::Error(_) => false,
+                Target::Done | Target::Error(_) | Target::ErrorOf(_) => false,
             };
             // An entry row fires only on the command's first cycle.
             stays && !r.is_entry && sends(r).next().is_some()

@@ -203,7 +203,7 @@ fn out_formula(
         | Leaf::SubStale(_) => true,
         Leaf::Buffer(b, _) => ctrl.reads.contains(&b),
         Leaf::Var(v, _) => !assigned.contains(&v),
-        Leaf::NewCommand | Leaf::SubStatus(_) => false,
+        Leaf::NewCommand | Leaf::SubStatus(_) | Leaf::SubErrorCode(_) => false,
     };
     if !exact || !matches!(index.ty, Type::Int(_)) {
         return None;

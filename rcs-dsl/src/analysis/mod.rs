@@ -581,6 +581,7 @@ impl<'ir> PlanAnalysis<'ir> {
             Leaf::PlanCycles => "plan_cycles".into(),
             Leaf::SubStatus(c) => format!("{}.status", sub(*c)),
             Leaf::SubStale(c) => format!("{}.{}", sub(*c), SubProp::StaleCycles.name()),
+            Leaf::SubErrorCode(c) => format!("{}.{}", sub(*c), SubProp::ErrorCode.name()),
             Leaf::Call(h, args) => printer.expr(&Expr {
                 kind: ExprKind::Call(*h, args.clone()),
                 ty: self.ctrl.hooks[h.index()].ret.clone(),
@@ -635,6 +636,10 @@ impl<'ir> PlanAnalysis<'ir> {
     /// A value as the language writes it.
     pub fn value_text(&self, ty: &Type, v: &Value) -> String {
         match (ty, v) {
+            (Type::ErrorCode(c), Value::Int(n)) => crate::error_codes::name_of(
+                self.ir.controller(*c),
+                rcs_runtime::ErrorCode(u16::try_from(*n).unwrap_or(u16::MAX)),
+            ),
             (_, Value::Bool(b)) => b.to_string(),
             (_, Value::Int(i)) => i.to_string(),
             (_, Value::Float(f)) if f.is_nan() => "NaN".into(),

@@ -30,6 +30,9 @@ pub enum Leaf {
     /// A subordinate's status, through the handshake.
     SubStatus(CtrlId),
     SubStale(CtrlId),
+    /// `X.error_code` (§8): an input the analysis does not model; an atom
+    /// that reads it is left undecided.
+    SubErrorCode(CtrlId),
     /// A subordinate's status field (`X.NAME`), then constant projections:
     /// an input the subordinate sets freely, like a `reads` buffer.
     SubField(CtrlId, VarId, Vec<Step>),
@@ -229,7 +232,9 @@ impl<'ir> Terms<'ir> {
         if is_leaf(e) {
             // A subordinate's status, seen through `X.done` and the like.
             let status = match &e.kind {
-                ExprKind::Sub(c, p) if *p != SubProp::StaleCycles => Some(*c),
+                ExprKind::Sub(c, p) if !matches!(p, SubProp::StaleCycles | SubProp::ErrorCode) => {
+                    Some(*c)
+                }
                 _ => None,
             };
             let ty = status.map_or(&e.ty, |_| &Type::Bool);
@@ -335,6 +340,7 @@ pub fn as_leaf(e: &Expr) -> Option<Leaf> {
         ExprKind::PlanCycles => Leaf::PlanCycles,
         ExprKind::Call(h, args) => Leaf::Call(*h, args.clone()),
         ExprKind::Sub(c, SubProp::StaleCycles) => Leaf::SubStale(*c),
+        ExprKind::Sub(c, SubProp::ErrorCode) => Leaf::SubErrorCode(*c),
         ExprKind::Sub(c, _) => Leaf::SubStatus(*c),
         ExprKind::CmdParam(_, p) => Leaf::Param(*p, Vec::new()),
         ExprKind::Var(v) => Leaf::Var(*v, Vec::new()),
@@ -390,7 +396,10 @@ fn same_leaf_as(e: &Expr, leaf: &Leaf) -> bool {
             h == k && xs.len() == ys.len() && xs.iter().zip(ys).all(|(x, y)| same_expr(x, y))
         }
         (ExprKind::Sub(c, SubProp::StaleCycles), Leaf::SubStale(d)) => c == d,
-        (ExprKind::Sub(c, p), Leaf::SubStatus(d)) => *p != SubProp::StaleCycles && c == d,
+        (ExprKind::Sub(c, SubProp::ErrorCode), Leaf::SubErrorCode(d)) => c == d,
+        (ExprKind::Sub(c, p), Leaf::SubStatus(d)) => {
+            !matches!(p, SubProp::StaleCycles | SubProp::ErrorCode) && c == d
+        }
         (
             _,
             Leaf::Param(_, steps)

@@ -374,7 +374,7 @@ pub(super) fn target_state(row: &Row, from: StateId) -> Option<StateId> {
     match row.to {
         Target::State(t) => Some(t),
         Target::Same => Some(from),
-        Target::Done | Target::Error(_) => None,
+        Target::Done | Target::Error(_) | Target::ErrorOf(_) => None,
     }
 }
 

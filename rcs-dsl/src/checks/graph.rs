@@ -53,7 +53,7 @@ pub(crate) fn analyse(p: &Plan, conditions: &PlanAnalysis) -> Analysis {
             Target::Same => continue,
             Target::State(s) => NodeIndex::new(s.index()),
             Target::Done => done,
-            Target::Error(_) => error,
+            Target::Error(_) | Target::ErrorOf(_) => error,
         };
         // An edge from each state the row can fire in: a row that earlier
         // rows always take first there (or that needs `new_command`
@@ -104,7 +104,7 @@ fn structural(p: &Plan) -> Analysis {
             Target::Same => continue,
             Target::State(s) => s.index(),
             Target::Done => done,
-            Target::Error(_) => error,
+            Target::Error(_) | Target::ErrorOf(_) => error,
         };
         if let crate::ir::From::DontCare(_) = row.from {
             if !star_targets.contains(&to) {

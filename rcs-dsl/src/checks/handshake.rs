@@ -42,7 +42,7 @@ impl Summary {
             .clone()
             .map(|((plan, _), graph)| {
                 plan.rows.iter().position(|r| {
-                    matches!(r.to, Target::Error(_))
+                    matches!(r.to, Target::Error(_) | Target::ErrorOf(_))
                         && !graph.never_matches[r.position as usize]
                         && super::plan::from_reachable(r, graph)
                 })
@@ -323,7 +323,7 @@ fn reported_by(plan: &Plan, conditions: &PlanAnalysis, graph: &Analysis) -> Vec<
         }
         match r.to {
             Target::Done => add(StatusId::DONE),
-            Target::Error(_) => add(StatusId::ERROR),
+            Target::Error(_) | Target::ErrorOf(_) => add(StatusId::ERROR),
             Target::State(_) | Target::Same => {}
         }
         for j in &r.jobs {

@@ -25,7 +25,7 @@ pub(crate) fn reported_hold(p: &Plan, s: usize) -> bool {
         .any(|r| match r.to {
             Target::State(t) => t == state,
             Target::Same => covers(&r.from, state),
-            Target::Done | Target::Error(_) => false,
+            Target::Done | Target::Error(_) | Target::ErrorOf(_) => false,
         })
 }
 

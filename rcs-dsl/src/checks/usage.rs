@@ -82,7 +82,23 @@ pub(crate) fn check_unused_in_controller(ir: &Ir, ci: CtrlId, sink: &mut Sink) -
         if let (ExprKind::Status(s), Type::Status(owner)) = (&e.kind, &e.ty) {
             uses.statuses.push((*owner, *s));
         }
+        // A declared code held as a value (`cause = FAULTED`) is used.
+        if let (ExprKind::ErrorCode(code), Type::ErrorCode(owner)) = (&e.kind, &e.ty) {
+            let declared =
+                usize::from(*code).checked_sub(usize::from(rcs_runtime::ErrorCode::FIRST_CUSTOM));
+            if let (true, Some(i)) = (*owner == ci, declared) {
+                if let Some(u) = error_used.get_mut(i) {
+                    *u = true;
+                }
+            }
+        }
     };
+    // Var initialisers name constants only; an error code among them is a use.
+    for v in &c.vars {
+        if let Some(init) = &v.init {
+            init.visit(&mut mark_expr);
+        }
+    }
     // The rows (conditions and jobs), then the `pre`/`post` jobs.
     for r in c.plans.iter().flat_map(|p| &p.rows) {
         r.visit_exprs(&mut mark_expr);

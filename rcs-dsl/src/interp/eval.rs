@@ -22,6 +22,7 @@ impl Interpreter<'_> {
             ExprKind::Bool(b) => Value::Bool(*b),
             ExprKind::Variant(_, v) => Value::Enum(*v),
             ExprKind::Status(s) => Value::Status(s.0 as u16),
+            ExprKind::ErrorCode(code) => Value::Int(i128::from(*code)),
             ExprKind::NewCommand => Value::Bool(self.bk.new_command()),
             ExprKind::StateCycles => Value::Int(self.bk.state_cycles() as i128),
             ExprKind::PlanCycles => Value::Int(self.bk.plan_cycles() as i128),
@@ -99,6 +100,7 @@ impl Interpreter<'_> {
                     SubProp::Executing => Value::Bool(v.executing()),
                     SubProp::Error => Value::Bool(v.error()),
                     SubProp::StaleCycles => Value::Int(v.stale_cycles as i128),
+                    SubProp::ErrorCode => Value::Int(i128::from(v.error.0)),
                 }
             }
             ExprKind::Unary(op, x) => {

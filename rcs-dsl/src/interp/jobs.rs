@@ -76,6 +76,11 @@ impl Interpreter<'_> {
             Job::Report {
                 error: Some(code), ..
             } => self.bk.report_error(ErrorCode::custom(code.0 as u16)),
+            Job::Report {
+                error_of: Some(v), ..
+            } => self
+                .bk
+                .report_error(crate::interp::error_code(&self.vars[v.index()])),
             Job::Report { status, .. } => self.bk.report(Status(status.0 as u16)),
             Job::Call(e) => {
                 self.eval(e, hooks);

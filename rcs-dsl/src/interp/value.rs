@@ -14,6 +14,8 @@ pub fn zero(ir: &Ir, t: &Type) -> Value {
         Type::Float(_) => Value::Float(0.0),
         Type::Enum(_) => Value::Enum(0),
         Type::Status(_) => Value::Status(0),
+        // An error code is its runtime number; 0 is no error.
+        Type::ErrorCode(_) => Value::Int(0),
         Type::Buffer(b) => Value::Buffer(
             ir.buffer_types[b.index()]
                 .fields
@@ -43,6 +45,17 @@ pub fn conform(ir: &Ir, t: &Type, v: &Value) -> Option<Value> {
             Value::Enum(*i)
         }
         (Type::Status(_), Value::Status(s)) => Value::Status(*s),
+        // Only a code the controller has: none, a built-in or a declared one.
+        (Type::ErrorCode(c), Value::Int(n)) => {
+            let code = rcs_runtime::ErrorCode(u16::try_from(*n).ok()?);
+            let declared = usize::from(code.0)
+                .checked_sub(usize::from(rcs_runtime::ErrorCode::FIRST_CUSTOM))
+                .is_some_and(|i| i < ir.controller(*c).errors.len());
+            if !(code.is_none() || code.is_builtin() || declared) {
+                return None;
+            }
+            Value::Int(*n)
+        }
         (Type::Buffer(b), Value::Buffer(fs)) => {
             let bt = &ir.buffer_types[b.index()];
             if fs.len() != bt.fields.len() {

@@ -72,7 +72,11 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
         for e in &c.entries {
             let docs = &e.outer.docs;
             match &e.kind {
-                ast::EntryKind::Command { name, params, .. } => {
+                ast::EntryKind::Command {
+                    name,
+                    params,
+                    accept,
+                } => {
                     let n = commands.len();
                     if !command_names.claim("command", name, n, |k| commands[k].span, diags) {
                         continue;
@@ -83,7 +87,17 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                         params: lower_params(g, params, diags),
                         plan: None,
                         span: name.span,
-                        accept: None,
+                        // Known from here on (other controllers' bodies
+                        // ask whether X can refuse); the condition itself
+                        // is lowered with the body.
+                        accept: accept.as_ref().map(|a| Accept {
+                            cond: Expr {
+                                kind: ExprKind::Bool(true),
+                                ty: Type::Bool,
+                                span: a.keyword,
+                            },
+                            span: a.keyword,
+                        }),
                     });
                 }
                 ast::EntryKind::Status(names) => {
@@ -115,6 +129,18 @@ pub(super) fn lower_declarations(g: &Globals, ir: &mut Ir, diags: &mut Diagnosti
                 }
                 ast::EntryKind::Error(names) => {
                     for name in names {
+                        if crate::error_codes::is_builtin(&name.text) {
+                            diags.push(
+                                Diagnostic::error(
+                                    Code::DuplicateDefinition,
+                                    format!("`{}` is a built-in error code", name.text),
+                                    name.span,
+                                    "already defined for every controller",
+                                )
+                                .with_help("declared codes come on top of UNKNOWN_COMMAND, INDEX_RANGE, HOOK_PANIC and REFUSED: choose another name"),
+                            );
+                            continue;
+                        }
                         let n = errors.len();
                         if !error_names.claim("error code", name, n, |k| errors[k].span, diags) {
                             continue;

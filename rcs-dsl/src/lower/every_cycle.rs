@@ -285,11 +285,15 @@ impl Cx<'_, '_> {
             );
             return None;
         }
-        let error = Some(self.error_code(code)?);
+        let (error, error_of) = match self.error_code(code)? {
+            super::plans::ErrorRef::Declared(e) => (Some(e), None),
+            super::plans::ErrorRef::Held(v) => (None, Some(v)),
+        };
         Some(Job::Report {
             status: StatusId::ERROR,
             span,
             error,
+            error_of,
         })
     }
 }

@@ -106,7 +106,11 @@ impl Cx<'_, '_> {
         let to = match &r.target {
             ast::Target::Same(_) => Target::Same,
             ast::Target::Error(None, _) => Target::Error(None),
-            ast::Target::Error(Some(code), _) => Target::Error(self.error_code(code)),
+            ast::Target::Error(Some(code), _) => match self.error_code(code) {
+                Some(ErrorRef::Held(v)) => Target::ErrorOf(v),
+                Some(ErrorRef::Declared(e)) => Target::Error(Some(e)),
+                None => Target::Error(None),
+            },
             ast::Target::State(n) if n.text == "Done" => Target::Done,
             ast::Target::State(n) => Target::State(intern(states, names, n)),
         };
@@ -146,6 +150,7 @@ impl Cx<'_, '_> {
                     status: StatusId(i as u32),
                     span: *span,
                     error: None,
+                    error_of: None,
                 }),
                 Some(_) => {
                     let target = "the runtime sets it; report `EXECUTING`, `DONE`, `ERROR(CODE)` or a custom status instead";
@@ -508,22 +513,80 @@ pub fn has_new_command_conjunct(e: &Expr) -> bool {
 impl Cx<'_, '_> {
     /// The controller's error code `code` (in `-> Error(CODE)` and
     /// `report ERROR(CODE)`), or `None` after reporting it undeclared.
-    pub(in crate::lower) fn error_code(&mut self, code: &ast::Name) -> Option<ErrorId> {
-        let Some(i) = self.names().errors.get(&code.text) else {
-            self.diags.push(
-                Diagnostic::error(
-                    Code::UnknownName,
-                    format!(
-                        "controller `{}` has no error code `{}`",
-                        self.c.name, code.text
-                    ),
-                    code.span,
-                    "not declared",
-                )
-                .with_help(format!("declare it: `error {}`", code.text)),
-            );
-            return None;
+    /// The code of `-> Error(NAME)` or `report ERROR(NAME)`: an error
+    /// this controller declares, or a var (or status field) of type
+    /// `error` that holds one (§8).
+    pub(in crate::lower) fn error_code(&mut self, code: &ast::Name) -> Option<ErrorRef> {
+        if let Some(i) = self.names().errors.get(&code.text) {
+            return Some(ErrorRef::Declared(ErrorId(i as u32)));
+        }
+        let held = self
+            .c
+            .vars
+            .iter()
+            .position(|v| v.name == code.text)
+            .map(|i| (VarId(i as u32), &self.c.vars[i]));
+        let (message, label, help) = match held {
+            Some((id, v)) if v.ty == Type::ErrorCode(self.ctrl) => {
+                return Some(ErrorRef::Held(id));
+            }
+            Some((_, v)) => (
+                format!(
+                    "`{}` is {}, not an error code",
+                    code.text,
+                    self.type_name(&v.ty)
+                ),
+                "not of type `error`",
+                format!(
+                    "a var that holds an error code has the type `error` (`var {}: error`); or end with a declared code: {}",
+                    code.text,
+                    self.declared_errors()
+                ),
+            ),
+            None if crate::error_codes::is_builtin(&code.text) => (
+                format!("`{}` is a built-in error the runtime reports", code.text),
+                "not one of this controller's codes",
+                format!(
+                    "a plan ends with a code its controller declares: `error MY_CODE` then `-> Error(MY_CODE)`; {}",
+                    self.declared_errors()
+                ),
+            ),
+            None => (
+                format!(
+                    "controller `{}` has no error code `{}`",
+                    self.c.name, code.text
+                ),
+                "not declared",
+                format!("declare it: `error {}`", code.text),
+            ),
         };
-        Some(ErrorId(i as u32))
+        self.diags
+            .push(Diagnostic::error(Code::UnknownName, message, code.span, label).with_help(help));
+        None
     }
+
+    /// "its codes are …" for a help.
+    fn declared_errors(&self) -> String {
+        if self.c.errors.is_empty() {
+            format!("`{}` declares none", self.c.name)
+        } else {
+            format!(
+                "the codes of `{}` are {}",
+                self.c.name,
+                self.c
+                    .errors
+                    .iter()
+                    .map(|e| e.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        }
+    }
+}
+
+/// What `Error(NAME)` names.
+pub(in crate::lower) enum ErrorRef {
+    Declared(ErrorId),
+    /// A var of type `error`.
+    Held(VarId),
 }

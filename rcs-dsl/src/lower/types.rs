@@ -88,6 +88,24 @@ pub(crate) fn resolve_type_in(
             if let Some(t) = primitive(&n.text) {
                 return Some(t);
             }
+            // `error`: one of this controller's error codes (§8).
+            if n.text == "error" {
+                return match scope {
+                    Some(ci) => Some(Type::ErrorCode(crate::ir::CtrlId(ci as u32))),
+                    None => {
+                        diags.push(
+                            Diagnostic::error(
+                                Code::TypeMismatch,
+                                "the type `error` outside a controller".to_string(),
+                                n.span,
+                                "whose error codes?",
+                            )
+                            .with_help("`error` holds one of a controller's error codes: give it to a var, a status field, a hook or a job-list parameter of that controller; a buffer field can be an integer or an enum"),
+                        );
+                        None
+                    }
+                };
+            }
             match g.names.get(n.text.as_str()) {
                 Some((ItemRef::Enum(id), _)) => Some(Type::Enum(*id)),
                 Some((ItemRef::BufferType(id), _)) => Some(Type::Buffer(*id)),

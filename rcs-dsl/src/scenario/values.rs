@@ -32,6 +32,15 @@ pub(super) fn value(
         )
     };
     Ok(match (t, v) {
+        // An error code by its name: a built-in or one the controller declares.
+        (Type::ErrorCode(c), Json::String(name)) => {
+            let code = if name == "none" {
+                Some(rcs_runtime::ErrorCode::NONE)
+            } else {
+                crate::error_codes::code_of(ir.controller(*c), name)
+            };
+            Value::Int(i128::from(code.ok_or_else(bad)?.0))
+        }
         (Type::Bool, Json::Bool(b)) => Value::Bool(*b),
         // YAML 1.2's other spellings (the reader takes only `true`/`false`).
         (Type::Bool, Json::String(s)) if matches!(s.as_str(), "True" | "TRUE") => Value::Bool(true),
@@ -163,6 +172,10 @@ pub(super) fn float_eq(a: &Value, b: &Value) -> bool {
 /// `Ahead`, `{ direction: Ahead, speed: 0.0 }`, `[1.0, 2.0, …]`.
 pub(super) fn show(ir: &Ir, t: &Type, v: &Value) -> String {
     match (t, v) {
+        (Type::ErrorCode(c), Value::Int(n)) => crate::error_codes::name_of(
+            ir.controller(*c),
+            rcs_runtime::ErrorCode(u16::try_from(*n).unwrap_or(u16::MAX)),
+        ),
         (_, Value::Bool(b)) => b.to_string(),
         (_, Value::Int(i)) => i.to_string(),
         (_, Value::Float(f)) => format!("{f:?}"),

@@ -221,6 +221,17 @@ impl<'a> Values<'a> {
                 let n = self.ir.controller(*c).statuses.len() as u16;
                 (0..n).prop_map(Value::Status).boxed()
             }
+            // No error, a built-in code, or one the controller declares.
+            Type::ErrorCode(c) => {
+                let declared = self.ir.controller(*c).errors.len() as u16;
+                let codes: Vec<Value> = [0u16]
+                    .into_iter()
+                    .chain(rcs_dsl::error_codes::BUILTIN.iter().map(|(_, k)| k.0))
+                    .chain((0..declared).map(|i| rcs_runtime::ErrorCode::custom(i).0))
+                    .map(|k| Value::Int(i128::from(k)))
+                    .collect();
+                select(codes).boxed()
+            }
             Type::Buffer(b) => self.ir.buffer_types[b.index()]
                 .fields
                 .iter()

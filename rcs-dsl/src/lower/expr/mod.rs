@@ -469,6 +469,7 @@ pub fn type_name(ir: &Ir, t: &Type) -> String {
         Type::Buffer(b) => ir.buffer_types[b.index()].name.clone(),
         Type::Array(e, n) => format!("[{}; {n}]", type_name(ir, e)),
         Type::Status(c) => format!("status of {}", ir.controllers[c.index()].name),
+        Type::ErrorCode(c) => format!("error code of {}", ir.controllers[c.index()].name),
         Type::Unit => "()".to_string(),
     }
 }

@@ -204,6 +204,7 @@ impl Cx<'_, '_> {
                 );
                 return (err_expr(span), Ty::Err);
             }
+            Some(Type::ErrorCode(cid)) => return self.error_name(*cid, name, span),
             _ => {}
         }
         let owners = crate::lower::consts::variant_owners(
@@ -497,6 +498,7 @@ impl Cx<'_, '_> {
             "executing" => (SubProp::Executing, Type::Bool),
             "error" => (SubProp::Error, Type::Bool),
             "stale_cycles" => (SubProp::StaleCycles, Type::Int(IntTy::U32)),
+            "error_code" => (SubProp::ErrorCode, Type::ErrorCode(cid)),
             other => {
                 if let Some(read) = self.sub_field(cid, span, other) {
                     return read;
@@ -522,5 +524,60 @@ impl Cx<'_, '_> {
             },
             Ty::Known(ty),
         )
+    }
+}
+
+impl Cx<'_, '_> {
+    /// A bare error name where an error code of controller `cid` is
+    /// expected (beside `X.error_code`, assigned to a var of type `error`):
+    /// one `cid` declares, or a built-in one it can have.
+    fn error_name(&mut self, cid: CtrlId, name: &ast::Name, span: Span) -> (Expr, Ty) {
+        let ctrl = &self.ir.controllers[cid.index()];
+        let refuses = ctrl.commands.iter().any(|k| k.accept.is_some());
+        let code = crate::error_codes::code_of(ctrl, &name.text)
+            .filter(|c| *c != rcs_runtime::ErrorCode::REFUSED || refuses);
+        if let Some(code) = code {
+            let ty = Type::ErrorCode(cid);
+            return (
+                Expr {
+                    kind: ExprKind::ErrorCode(code.0),
+                    ty: ty.clone(),
+                    span,
+                },
+                Ty::Known(ty),
+            );
+        }
+        let codes: Vec<&str> = crate::error_codes::BUILTIN
+            .iter()
+            .map(|(n, _)| *n)
+            .filter(|n| *n != "REFUSED" || refuses)
+            .chain(ctrl.errors.iter().map(|e| e.name.as_str()))
+            .collect();
+        let help = if name.text == "REFUSED" {
+            format!(
+                "`{}` refuses no command: REFUSED comes only from a verb declared with `accept when`; its codes are {}",
+                ctrl.name,
+                codes.join(", ")
+            )
+        } else {
+            format!(
+                "the error codes of `{}` are: {}",
+                ctrl.name,
+                codes.join(", ")
+            )
+        };
+        self.diags.push(
+            Diagnostic::error(
+                Code::UnknownName,
+                format!(
+                    "controller `{}` has no error code `{}`",
+                    ctrl.name, name.text
+                ),
+                name.span,
+                "no such error code",
+            )
+            .with_help(help),
+        );
+        (err_expr(span), Ty::Err)
     }
 }

@@ -137,6 +137,11 @@ impl Cx<'_, '_> {
                         );
                     } else if status(&ta) && status(&tb) {
                         self.help_last("each controller has its own statuses: compare each one with a status name, as in `X.status == DONE`");
+                    } else if [&ta, &tb]
+                        .iter()
+                        .any(|t| matches!(t, Ty::Known(Type::ErrorCode(_))))
+                    {
+                        self.help_last("an error code is one of a controller's error names, not a number: compare with a name, as in `X.error_code == FAULTED`");
                     }
                     return (err_expr(span), Ty::Err);
                 };

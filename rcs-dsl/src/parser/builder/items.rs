@@ -201,6 +201,12 @@ impl Builder {
                     len_expr,
                 }
             }
+            // `error` is a reserved word, and a type (§8): a controller's
+            // error codes.
+            _ if c.as_str() == "error" => TypeExpr::Named(crate::ast::Name {
+                text: c.as_str().into(),
+                span: self.token_span(&c),
+            }),
             _ => TypeExpr::Named(self.name(c)),
         }
     }

@@ -15,6 +15,7 @@ use crate::source::{FileId, Span};
 use pest::Parser as _;
 
 mod builder;
+mod foreign;
 mod syntax_error;
 
 use builder::Builder;

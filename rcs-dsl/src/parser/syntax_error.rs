@@ -79,6 +79,16 @@ pub(super) fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>
         let eof = expected.remove(i);
         expected.push(eof);
     }
+    // `if`, `&=`, `and`, `0x1.8`…: named for what they are.
+    if let Some(f) = super::foreign::foreign_spelling(text, pos) {
+        return Diagnostic::error(
+            Code::Syntax,
+            f.message,
+            Span::new(file, f.start, f.end),
+            f.label,
+        )
+        .with_help(f.help);
+    }
     let found = describe_found(text, pos);
     let end = found_end(text, pos);
     let message = if expected.is_empty() {

@@ -27,6 +27,15 @@ impl<'a> Printer<'a> {
         s
     }
 
+    /// The comparison `e` was written as, if it is a time compared with a
+    /// duration (`lower::time`).
+    fn written_time(&self, e: &Expr) -> Option<&'a WrittenTime> {
+        if !matches!(e.kind, ExprKind::Binary(..)) || self.ctrl.written_times.is_empty() {
+            return None;
+        }
+        self.ctrl.written_times.iter().find(|w| w.span == e.span)
+    }
+
     fn strength(e: &Expr) -> u8 {
         match &e.kind {
             ExprKind::Binary(op, ..) => op.precedence(),
@@ -44,6 +53,14 @@ impl<'a> Printer<'a> {
         if paren {
             out.push('(');
         }
+        // A time compared with a duration, lowered to cycles: as written.
+        if let Some(w) = self.written_time(e) {
+            out.push_str(&w.text);
+            if paren {
+                out.push(')');
+            }
+            return;
+        }
         match &e.kind {
             ExprKind::Int(v) => out.push_str(&v.to_string()),
             ExprKind::Float(v) => out.push_str(&float(*v)),
@@ -60,6 +77,10 @@ impl<'a> Printer<'a> {
             }
             ExprKind::NewCommand => out.push_str("new_command"),
             ExprKind::StateCycles => out.push_str("state_cycles"),
+            ExprKind::BufferStale(b) => {
+                out.push_str(&self.ir.buffers[b.index()].name);
+                out.push_str(".stale_cycles");
+            }
             ExprKind::PlanCycles => out.push_str("plan_cycles"),
             ExprKind::CmdParam(c, p) => {
                 out.push_str("cmd.");

@@ -471,7 +471,10 @@ impl PlanAnalysis<'_> {
                 unsure |= match &self.terms.leaves[l].0 {
                     Leaf::Var(..) => !given.iter().any(|(g, _)| *g == l),
                     Leaf::Buffer(b, _) => self.ctrl.writes.contains(b),
-                    Leaf::StateCycles | Leaf::PlanCycles | Leaf::SubStale(_) => true,
+                    Leaf::StateCycles
+                    | Leaf::PlanCycles
+                    | Leaf::SubStale(_)
+                    | Leaf::BufStale(_) => true,
                     Leaf::NewCommand
                     | Leaf::Param(..)
                     | Leaf::Call(..)

@@ -13,6 +13,7 @@ mod loops;
 pub(crate) mod names;
 mod plan;
 mod report;
+mod time;
 mod usage;
 
 use crate::analysis::PlanAnalysis;
@@ -184,6 +185,7 @@ fn analyse_controller<'ir>(ir: &'ir Ir, ci: CtrlId, levels: &LintLevels) -> Anal
         check_plan(ir, c, p, conditions, analysis, &mut sink);
     }
     usage::check_float_equality(c, &mut sink);
+    time::check_timer_resolution(ir, ci, &mut sink);
     let uses = usage::check_unused_in_controller(ir, ci, &mut sink);
     let summary = handshake::Summary::of(c, &conditions, &graphs);
     // Only the handshake checks read the analyses again, and only those of

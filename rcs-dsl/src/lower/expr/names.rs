@@ -373,6 +373,16 @@ impl Cx<'_, '_> {
         field: &ast::Name,
         span: Span,
     ) -> (Expr, Ty) {
+        if field.text == "stale_time" {
+            let whole = ast::Expr {
+                kind: ast::ExprKind::Field(Box::new(base.clone()), field.clone()),
+                span,
+            };
+            return self.time_out_of_place(&whole);
+        }
+        if let Some(watchdog) = self.buffer_watchdog(base, field, span) {
+            return watchdog;
+        }
         // `X.prop` on a controller name: the handshake view of a subordinate.
         if let ast::ExprKind::Path(None, x) = &base.kind {
             if self.value(&x.text).is_none() || matches!(self.value(&x.text), Some(Value::Sub)) {

@@ -319,7 +319,12 @@ impl Diagnostic {
 
     /// A note: information the user should have, counted as neither error
     /// nor warning.
-    pub fn note(code: Code, message: impl Into<String>, span: Span, label: impl Into<String>) -> Self {
+    pub fn note(
+        code: Code,
+        message: impl Into<String>,
+        span: Span,
+        label: impl Into<String>,
+    ) -> Self {
         let mut d = Diagnostic::error(code, message, span, label);
         d.severity = Severity::Note;
         d

@@ -12,7 +12,7 @@
 
 use crate::ir::*;
 use rcs_runtime::{
-    BufferWatch, Bookkeeping, ErrorCode, Stamped, StatusBuffer, SubordinateLink, SubordinateView,
+    Bookkeeping, BufferWatch, ErrorCode, Stamped, StatusBuffer, SubordinateLink, SubordinateView,
     Tick,
 };
 

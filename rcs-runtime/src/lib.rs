@@ -233,8 +233,8 @@ pub use schema::Schema;
 #[doc(hidden)]
 pub use serde;
 pub use signal::CycleSignal;
-pub use watchdog::BufferWatch;
 pub use trace::{read_trace, TraceError, TraceHeader, TraceRecord, TraceSink, TRACE_VERSION};
+pub use watchdog::BufferWatch;
 
 /// Include the Rust code `rcsc` generated for a plan set from a build script.
 ///

@@ -22,7 +22,11 @@ pub(crate) fn check_timer_resolution(ir: &Ir, ci: CtrlId, sink: &mut Sink) {
     let cpu_name = cpu.map_or("main", |cpu| cpu.name.as_str());
     // The note, once per controller, at its first time (in source order).
     if !cpu.is_some_and(|cpu| cpu.period_given) {
-        if let Some(first) = c.written_times.iter().min_by_key(|w| (w.span.file, w.span.start)) {
+        if let Some(first) = c
+            .written_times
+            .iter()
+            .min_by_key(|w| (w.span.file, w.span.start))
+        {
             sink.error(
                 Diagnostic::note(
                     Code::Lint(Lint::TimerResolution),
@@ -69,7 +73,7 @@ fn finding(w: &WrittenTime, cpu: &str) -> Diagnostic {
     };
     let when = match w.op {
         BinOp::Gt | BinOp::Ge => format!("fires after {}", at(n)),
-        _ => format!("stops holding after {}", at(n)),
+        _ => format!("stops holding at {}", at(n)),
     };
     let (down, up) = (
         w.duration_ns / w.period_ns * w.period_ns,

@@ -66,6 +66,39 @@ pub(crate) fn duration_not_number(span: Span, hint: Option<&Type>) -> Diagnostic
     )
 }
 
+/// The help for a timer written as another language writes it: IEC 61131
+/// `TON(…)`/`TOF`/`TP`, Stateflow `after(2, sec)`, SCXML-style `delay(…)`.
+pub(in crate::lower) fn timer_spelling(name: &str) -> Option<String> {
+    match name {
+        "TON" | "TOF" | "TP" | "ton" | "tof" | "after" | "delay" | "timeout" | "timer" | "wait" => {
+            Some(format!(
+                "rcsc has no timer functions: a row compares the time in its state with a duration, \
+                 `S1 when state_time > 2s -> …` (`{name}(…)` is another language's timer)"
+            ))
+        }
+        _ => None,
+    }
+}
+
+/// `B.stale_cycles` / `B.stale_time` for a buffer of the plan set that this
+/// controller does not read: the diagnostic, if `x` names such a buffer.
+pub(in crate::lower) fn unread_buffer(cx: &Cx, x: &ast::Name) -> Option<Diagnostic> {
+    let b = cx.ir.buffers.iter().find(|b| b.name == x.text.as_str())?;
+    let ty = &cx.ir.buffer_types[b.ty.index()].name;
+    Some(
+        Diagnostic::error(
+            Code::UnknownName,
+            format!("`{}` is not a `reads` buffer of `{}`", x.text, cx.c.name),
+            x.span,
+            "not read by this controller",
+        )
+        .with_help(format!(
+            "a watchdog counts the cycles since a buffer this controller reads was written: add `reads {}: {ty}`",
+            x.text
+        )),
+    )
+}
+
 /// Whether an AST operand is a duration or a time (a time counter or a
 /// duration literal or constant), so that its comparison is lowered here.
 pub(in crate::lower) fn mentions_time(cx: &Cx, e: &ast::Expr) -> bool {
@@ -128,10 +161,18 @@ impl Cx<'_, '_> {
             (Side::Time(t), Side::Duration(ns)) => (t, ns, op, None),
             (Side::Duration(ns), Side::Time(t)) => (t, ns, flipped(op), None),
             (Side::Time(_), Side::Time(_)) => {
-                return self.time_mismatch(span, "two times compared", "compare a time with a duration: `state_time > 5s`".into())
+                return self.time_mismatch(
+                    span,
+                    "two times compared",
+                    "compare a time with a duration: `state_time > 5s`".into(),
+                )
             }
             (Side::Duration(_), Side::Duration(_)) => {
-                return self.time_mismatch(span, "two durations compared", "compare a time with a duration: `state_time > 5s`".into())
+                return self.time_mismatch(
+                    span,
+                    "two durations compared",
+                    "compare a time with a duration: `state_time > 5s`".into(),
+                )
             }
             (Side::Time(_), Side::Other) => (err_expr(span), 0, op, Some((r, true))),
             (Side::Other, Side::Time(_)) => (err_expr(span), 0, op, Some((l, true))),
@@ -206,8 +247,13 @@ impl Cx<'_, '_> {
 
     fn time_mismatch(&mut self, span: Span, message: &str, help: String) -> (Expr, Ty) {
         self.diags.push(
-            Diagnostic::error(Code::TypeMismatch, message.to_string(), span, "not a time compared with a duration")
-                .with_help(help),
+            Diagnostic::error(
+                Code::TypeMismatch,
+                message.to_string(),
+                span,
+                "not a time compared with a duration by `<`, `<=`, `>` or `>=`",
+            )
+            .with_help(help),
         );
         (err_expr(span), Ty::Err)
     }
@@ -266,7 +312,8 @@ impl Cx<'_, '_> {
             return (err_expr(span), Ty::Err);
         }
         self.diags.push(
-            Diagnostic::error(Code::TypeMismatch, message, other.span, "not a duration").with_help(help),
+            Diagnostic::error(Code::TypeMismatch, message, other.span, "not a duration")
+                .with_help(help),
         );
         (err_expr(span), Ty::Err)
     }
@@ -334,7 +381,9 @@ impl Cx<'_, '_> {
                         f.span,
                         "no watchdog here",
                     )
-                    .with_help("`X.stale_time` for a subordinate X, `B.stale_time` for a `reads` buffer B"),
+                    .with_help(
+                        "`X.stale_time` for a subordinate X, `B.stale_time` for a `reads` buffer B",
+                    ),
                 );
                 err_expr(span)
             }

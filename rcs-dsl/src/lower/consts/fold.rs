@@ -94,7 +94,8 @@ impl Folder<'_, '_> {
             | ast::ExprKind::StateTime
             | ast::ExprKind::PlanTime => self.not_constant(e.span, "a plan quantity"),
             ast::ExprKind::Duration(_) => {
-                self.diags.push(super::super::time::duration_not_number(e.span, hint));
+                self.diags
+                    .push(super::super::time::duration_not_number(e.span, hint));
                 None
             }
             ast::ExprKind::CmdParam(_) => self.not_constant(e.span, "a command parameter"),
@@ -194,7 +195,8 @@ impl Folder<'_, '_> {
 
     fn name(&mut self, scope: Scope, n: &ast::Name, hint: Option<&Type>) -> Option<Folded> {
         if self.durations.get(scope, &n.text).is_some() {
-            self.diags.push(super::super::time::duration_not_number(n.span, hint));
+            self.diags
+                .push(super::super::time::duration_not_number(n.span, hint));
             return None;
         }
         let mut key = (scope, n.text.to_string());

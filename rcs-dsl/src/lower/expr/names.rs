@@ -302,13 +302,14 @@ impl Cx<'_, '_> {
                         name.span,
                         "not a hook",
                     )
-                    .with_help(match crate::builtin::closest(&name.text) {
-                        Some(b) => format!(
+                    .with_help(match (super::super::time::timer_spelling(&name.text), crate::builtin::closest(&name.text)) {
+                        (Some(help), _) => help,
+                        (None, Some(b)) => format!(
                             "did you mean the built-in function `{}`? Else declare a hook: `hook {}(…) -> T`",
                             b.name(),
                             name.text
                         ),
-                        None => format!("declare it: `hook {}(…) -> T`", name.text),
+                        (None, None) => format!("declare it: `hook {}(…) -> T`", name.text),
                     }),
                 );
                 for a in args {
@@ -390,6 +391,12 @@ impl Cx<'_, '_> {
                     return self.sub_prop(*cid, x, field, span);
                 }
                 let sub_prop = ["status", "done", "executing", "error", "stale_cycles"];
+                if field.text == "stale_cycles" && self.value(&x.text).is_none() {
+                    if let Some(d) = super::super::time::unread_buffer(self, x) {
+                        self.diags.push(d);
+                        return (err_expr(span), Ty::Err);
+                    }
+                }
                 if self.value(&x.text).is_none() && sub_prop.contains(&field.text.as_str()) {
                     self.diags.push(
                         Diagnostic::error(

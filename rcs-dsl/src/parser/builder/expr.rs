@@ -381,7 +381,11 @@ impl Builder {
         use crate::time::{parse_literal, split_unit, LiteralError};
         let (number, unit) = split_unit(text);
         if number == "0" && (unit.starts_with('x') || unit.starts_with('b')) {
-            let what = if unit.starts_with('x') { "hex" } else { "binary" };
+            let what = if unit.starts_with('x') {
+                "hex"
+            } else {
+                "binary"
+            };
             self.error(
                 span,
                 format!("`{text}` is not a {what} literal"),

@@ -284,9 +284,12 @@ pub struct Controller {
 pub struct WrittenTime {
     /// The comparison's span (the lowered `Binary` expression's).
     pub span: Span,
-    /// The comparison as written, `state_time > 5s` (filled in from the
+    /// The duration as written, `5s` or `TIMEOUT` (filled in from the
     /// source once the controller is lowered).
-    pub text: String,
+    pub duration: String,
+    /// Whether the time is written on the left (`state_time > 5s`; else
+    /// `5s < state_time`).
+    pub time_left: bool,
     /// The operator with the time on the left (`5s < state_time` is `>`).
     pub op: crate::ast::BinOp,
     pub duration_ns: u64,
@@ -294,11 +297,9 @@ pub struct WrittenTime {
     pub period_ns: u64,
     /// The cycle count the counter is compared with.
     pub threshold: u64,
-    /// The two sides' spans and the operator, as written (in source order).
+    /// The duration's span, as written.
     #[serde(skip)]
-    pub parts: [Span; 2],
-    #[serde(skip)]
-    pub written_op: crate::ast::BinOp,
+    pub duration_span: Span,
 }
 
 /// What an instance was made from: its type, and its arguments and

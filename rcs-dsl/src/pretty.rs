@@ -36,6 +36,26 @@ impl<'a> Printer<'a> {
         self.ctrl.written_times.iter().find(|w| w.span == e.span)
     }
 
+    /// `state_time > 5s` for a comparison lowered to `state_cycles > 500`:
+    /// the time named from its counter (`X.stale_time`, with the buffer or
+    /// subordinate this controller binds), the duration and the order as
+    /// written.
+    pub fn written_text(&self, w: &WrittenTime, counter: &Expr) -> String {
+        let time = match &counter.kind {
+            ExprKind::StateCycles => "state_time".to_string(),
+            ExprKind::PlanCycles => "plan_time".to_string(),
+            ExprKind::Sub(c, _) => format!("{}.stale_time", self.ir.controller(*c).name),
+            ExprKind::BufferStale(b) => format!("{}.stale_time", self.ir.buffers[b.index()].name),
+            _ => self.expr(counter),
+        };
+        if w.time_left {
+            format!("{time} {} {}", w.op.symbol(), w.duration)
+        } else {
+            let op = crate::time::flipped(w.op);
+            format!("{} {} {time}", w.duration, op.symbol())
+        }
+    }
+
     fn strength(e: &Expr) -> u8 {
         match &e.kind {
             ExprKind::Binary(op, ..) => op.precedence(),
@@ -54,8 +74,8 @@ impl<'a> Printer<'a> {
             out.push('(');
         }
         // A time compared with a duration, lowered to cycles: as written.
-        if let Some(w) = self.written_time(e) {
-            out.push_str(&w.text);
+        if let (Some(w), ExprKind::Binary(_, operands)) = (self.written_time(e), &e.kind) {
+            out.push_str(&self.written_text(w, &operands[0]));
             if paren {
                 out.push(')');
             }

@@ -51,7 +51,13 @@ pub(crate) fn check_timer_resolution(ir: &Ir, ci: CtrlId, sink: &mut Sink) {
         if w.duration_ns % w.period_ns == 0 {
             return;
         }
-        sink.lint(Some(c), plan, finding(w, cpu_name));
+        let text = match &e.kind {
+            crate::ir::ExprKind::Binary(_, operands) => {
+                crate::pretty::Printer::new(ir, c, plan).written_text(w, &operands[0])
+            }
+            _ => w.duration.clone(),
+        };
+        sink.lint(Some(c), plan, finding(w, &text, cpu_name));
     };
     for p in &c.plans {
         for r in &p.rows {
@@ -64,7 +70,7 @@ pub(crate) fn check_timer_resolution(ir: &Ir, ci: CtrlId, sink: &mut Sink) {
 }
 
 /// `timer_resolution` for one comparison: when it really fires.
-fn finding(w: &WrittenTime, cpu: &str) -> Diagnostic {
+fn finding(w: &WrittenTime, text: &str, cpu: &str) -> Diagnostic {
     let n = first_change(w.op, w.threshold);
     let at = |n: u64| {
         let ns = u128::from(n) * u128::from(w.period_ns);
@@ -92,7 +98,7 @@ fn finding(w: &WrittenTime, cpu: &str) -> Diagnostic {
     .with_note(format!(
         "time is cycles × {}, so `{}` {when}",
         format_ns(w.period_ns),
-        w.text
+        text
     ))
     .with_help(format!(
         "write a multiple of the period ({}{}), or allow the lint with `#[allow(timer_resolution)]`",

@@ -156,7 +156,7 @@ impl Cx<'_, '_> {
         span: Span,
     ) -> (Expr, Ty) {
         let (a, b) = (self.side(l), self.side(r));
-        let written_op = op;
+        let time_left = matches!(self.side_kind(l), SideKind::Time);
         let (time, ns, op, other) = match (a, b) {
             (Side::Time(t), Side::Duration(ns)) => (t, ns, op, None),
             (Side::Duration(ns), Side::Time(t)) => (t, ns, flipped(op), None),
@@ -212,16 +212,16 @@ impl Cx<'_, '_> {
                     .to_string(),
             );
         }
-        let parts = [l.span, r.span];
+        let duration_span = if time_left { r.span } else { l.span };
         self.time.written.push(WrittenTime {
             span,
-            text: String::new(),
+            duration: String::new(),
+            time_left,
             op,
             duration_ns: ns,
             period_ns: period,
             threshold,
-            parts,
-            written_op,
+            duration_span,
         });
         let u32_ty = Type::Int(IntTy::U32);
         let mut time = time;
@@ -229,11 +229,7 @@ impl Cx<'_, '_> {
         let k = Expr {
             kind: ExprKind::Int(i128::from(threshold)),
             ty: u32_ty,
-            span: if matches!(self.side_kind(l), SideKind::Duration) {
-                l.span
-            } else {
-                r.span
-            },
+            span: duration_span,
         };
         (
             Expr {
@@ -452,19 +448,15 @@ enum SideKind {
     Other,
 }
 
-/// Fill in each comparison's text from the source, as written: both
-/// sides with the operator between them, in source order.
+/// Fill in each duration's text from the source, as written.
 pub(super) fn fill_texts(written: &mut [WrittenTime], sources: &crate::source::SourceMap) {
     for w in written {
-        let part = |s: Span| {
-            sources
-                .get(s.file)
-                .text
-                .get(s.start as usize..s.end as usize)
-                .map(str::to_string)
-                .unwrap_or_default()
-        };
-        let (l, r) = (part(w.parts[0]), part(w.parts[1]));
-        w.text = format!("{l} {} {r}", w.written_op.symbol());
+        let s = w.duration_span;
+        w.duration = sources
+            .get(s.file)
+            .text
+            .get(s.start as usize..s.end as usize)
+            .unwrap_or_default()
+            .to_string();
     }
 }

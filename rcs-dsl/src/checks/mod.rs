@@ -33,6 +33,14 @@ impl Sink<'_> {
         self.diags.push(d);
     }
 
+    /// A note under a lint's code inside `ctrl`: shown unless the lint is
+    /// allowed there, and never more than a note (it states a fact).
+    pub fn note(&mut self, ctrl: &Controller, lint: Lint, d: Diagnostic) {
+        if self.levels.at(lint, &[&ctrl.lints]) != crate::lint::Level::Allow {
+            self.diags.push(d);
+        }
+    }
+
     /// A lint finding inside `ctrl` (and `plan`, if any); attributes there apply.
     pub fn lint(&mut self, ctrl: Option<&Controller>, plan: Option<&Plan>, d: Diagnostic) {
         let crate::diagnostic::Code::Lint(lint) = d.code else {

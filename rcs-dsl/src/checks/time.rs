@@ -27,7 +27,9 @@ pub(crate) fn check_timer_resolution(ir: &Ir, ci: CtrlId, sink: &mut Sink) {
             .iter()
             .min_by_key(|w| (w.span.file, w.span.start))
         {
-            sink.error(
+            sink.note(
+                c,
+                Lint::TimerResolution,
                 Diagnostic::note(
                     Code::Lint(Lint::TimerResolution),
                     format!(

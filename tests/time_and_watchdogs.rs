@@ -1,4 +1,8 @@
-//! Property of time in seconds (LANGUAGE.md §8 "Time"): for random CPU
+//! Time in seconds and watchdogs on buffers (LANGUAGE.md §8), end to end
+//! through `rcsc test`: the property below, the ok cases' scenarios on both
+//! backends, and the scenario key `silent:` refused where it is wrong.
+//!
+//! The property: for random CPU
 //! periods and durations, a row `S1 when state_time > D` fires on exactly
 //! the first cycle at which the time in S1 (cycles × period) exceeds D —
 //! never a cycle early, never a cycle late — on the interpreter and on the
@@ -256,4 +260,42 @@ fn durations_and_watchdogs_pass_their_scenarios_on_both_backends() {
         interp,
         "identical reports on both backends"
     );
+}
+
+/// `silent:` names `reads` buffers; a subordinate, an unknown name, or a
+/// buffer both written and held in one step is refused with its line.
+#[test]
+fn silent_is_refused_where_it_names_no_reads_buffer() {
+    let set = "tests/data/ok/0630_buffer_watchdog";
+    let cases = [
+        (
+            "controller: AXIS\nsteps:\n  - command: MOVE\n  - silent: [DRIVE]\n",
+            "4: error: `AXIS` reads no buffer `DRIVE`; a subordinate is held with `subordinates: { DRIVE: { silent: true } }`",
+        ),
+        (
+            "controller: DRIVE\nsteps:\n  - command: ENABLE\n  - silent: [framez]\n",
+            "4: error: `DRIVE` reads no buffer `framez`",
+        ),
+        (
+            "controller: DRIVE\nsteps:\n  - command: ENABLE\n  - silent: [frame]\n    reads: { frame: { position: 1 } }\n",
+            "4: error: `frame` is both written (`reads:`) and `silent:` in one step",
+        ),
+        (
+            "controller: DRIVE\nsteps:\n  - command: ENABLE\n  - silent: 3\n",
+            "4: error: `silent` is a list of `reads` buffers held unwritten",
+        ),
+    ];
+    for (k, (scenario, want)) in cases.iter().enumerate() {
+        let dir = scratch(&format!("silent{k}"), &[("s.scenario.yaml", scenario)]);
+        let file = dir.join("s.scenario.yaml");
+        let out = rcsc(&["test", set, file.to_str().unwrap()]);
+        let stdout = text(&out.stdout);
+        assert_ne!(out.status.code(), Some(0), "{stdout}");
+        assert!(
+            stdout.contains(want),
+            "want `{want}` in:\n{stdout}{}",
+            text(&out.stderr)
+        );
+        std::fs::remove_dir_all(dir).ok();
+    }
 }

@@ -48,7 +48,7 @@ fn written(ns: u64, rng: &mut Rng) -> String {
         ("s", 1_000_000_000),
     ];
     let (unit, scale) = units[rng.below(4) as usize];
-    if ns % scale == 0 {
+    if ns.is_multiple_of(scale) {
         return format!("{}{unit}", ns / scale);
     }
     let digits = scale.ilog10() as usize;

@@ -142,7 +142,7 @@ pub fn format_ns(ns: u64) -> String {
 /// `c·p <= d ⇔ c <= ⌊d/p⌋`.
 pub fn cycle_threshold(op: BinOp, duration_ns: u64, period_ns: u64) -> (BinOp, u64) {
     let floor = duration_ns / period_ns;
-    let ceil = floor + u64::from(duration_ns % period_ns != 0);
+    let ceil = floor + u64::from(!duration_ns.is_multiple_of(period_ns));
     match op {
         BinOp::Gt | BinOp::Le => (op, floor),
         _ => (op, ceil),

@@ -50,7 +50,7 @@ pub(crate) fn check_timer_resolution(ir: &Ir, ci: CtrlId, sink: &mut Sink) {
         let Some(w) = c.written_times.iter().find(|w| w.span == e.span) else {
             return;
         };
-        if w.duration_ns % w.period_ns == 0 {
+        if w.duration_ns.is_multiple_of(w.period_ns) {
             return;
         }
         let text = match &e.kind {
@@ -83,10 +83,13 @@ fn finding(w: &WrittenTime, text: &str, cpu: &str) -> Diagnostic {
         BinOp::Gt | BinOp::Ge => format!("fires after {}", at(n)),
         _ => format!("stops holding at {}", at(n)),
     };
-    let (down, up) = (
-        w.duration_ns / w.period_ns * w.period_ns,
-        (w.duration_ns / w.period_ns + 1) * w.period_ns,
-    );
+    let below = w.duration_ns / w.period_ns * w.period_ns;
+    let up = below.saturating_add(w.period_ns);
+    let down = if below > 0 {
+        format!("`{}` or ", format_ns(below))
+    } else {
+        String::new()
+    };
     Diagnostic::lint(
         Lint::TimerResolution,
         format!(
@@ -103,12 +106,7 @@ fn finding(w: &WrittenTime, text: &str, cpu: &str) -> Diagnostic {
         text
     ))
     .with_help(format!(
-        "write a multiple of the period ({}{}), or allow the lint with `#[allow(timer_resolution)]`",
-        if down > 0 {
-            format!("`{}` or ", format_ns(down))
-        } else {
-            String::new()
-        },
-        format!("`{}`", format_ns(up))
+        "write a multiple of the period ({down}`{}`), or allow the lint with `#[allow(timer_resolution)]`",
+        format_ns(up)
     ))
 }

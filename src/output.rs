@@ -44,6 +44,10 @@ pub(crate) fn print_diagnostics(
     for d in &checked.diagnostics {
         if d.severity == rcs_dsl::Severity::Error {
             counts.errors += 1;
+        } else if d.severity == rcs_dsl::Severity::Note {
+            if common.quiet {
+                continue;
+            }
         } else {
             counts.warnings += 1;
             if common.quiet {

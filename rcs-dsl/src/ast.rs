@@ -471,6 +471,12 @@ pub enum ExprKind {
     NewCommand,
     StateCycles,
     PlanCycles,
+    /// A duration literal (`50ms`, `1.5s`), in nanoseconds; its text is
+    /// the span's (LANGUAGE.md §8 "Time").
+    Duration(u64),
+    /// `state_time`, `plan_time`: the counters times the CPU's period.
+    StateTime,
+    PlanTime,
     /// `cmd.P`
     CmdParam(Name),
     /// A bare name or `Type::Variant` (the qualifier boxed: it is rare).

@@ -14,6 +14,9 @@ use serde::Serialize;
 pub enum Severity {
     Error,
     Warning,
+    /// Information, neither an error nor a warning (the default period a
+    /// controller's times are counted in).
+    Note,
 }
 
 impl Severity {
@@ -21,6 +24,7 @@ impl Severity {
         match self {
             Severity::Error => "error",
             Severity::Warning => "warning",
+            Severity::Note => "note",
         }
     }
 }
@@ -209,6 +213,9 @@ impl Code {
                 "a supervisor waits for a status the subordinate never reports"
             }
             Code::Lint(Lint::IndexRange) => "an index by a run-time value can fall outside its array",
+            Code::Lint(Lint::TimerResolution) => {
+                "a duration is not a whole number of the CPU's periods: the comparison fires later than written"
+            }
             Code::EveryCycleDecision => {
                 "a `pre` or `post` block sends, reports or changes state: decisions belong in the rows"
             }
@@ -313,6 +320,19 @@ impl Diagnostic {
     ) -> Self {
         let mut d = Diagnostic::error(Code::Lint(lint), message, span, label);
         d.severity = Severity::Warning;
+        d
+    }
+
+    /// A note: information the user should have, counted as neither error
+    /// nor warning.
+    pub fn note(
+        code: Code,
+        message: impl Into<String>,
+        span: Span,
+        label: impl Into<String>,
+    ) -> Self {
+        let mut d = Diagnostic::error(code, message, span, label);
+        d.severity = Severity::Note;
         d
     }
 

@@ -12,7 +12,8 @@
 
 use crate::ir::*;
 use rcs_runtime::{
-    Bookkeeping, ErrorCode, Stamped, StatusBuffer, SubordinateLink, SubordinateView, Tick,
+    Bookkeeping, BufferWatch, ErrorCode, Stamped, StatusBuffer, SubordinateLink, SubordinateView,
+    Tick,
 };
 
 use crate::arith::truthy;
@@ -102,6 +103,9 @@ pub struct Interpreter<'ir> {
     active_params: Vec<Value>,
     vars: Vec<Value>,
     reads: Vec<Value>,
+    /// Each `reads` buffer's write generation (one more per [`set_read`](Self::set_read)),
+    /// and this controller's watch on it (`B.stale_cycles`, step 1).
+    read_watch: Vec<(u64, BufferWatch)>,
     writes: Vec<Value>,
     subs: Vec<SubState>,
     /// While conditions are evaluated: the hook calls made so far this
@@ -128,6 +132,7 @@ impl<'ir> Interpreter<'ir> {
                 .iter()
                 .map(|b| zero(ir, &Type::Buffer(ir.buffers[b.index()].ty)))
                 .collect(),
+            read_watch: vec![(0, BufferWatch::new()); c.reads.len()],
             writes: c
                 .writes
                 .iter()
@@ -174,9 +179,11 @@ impl<'ir> Interpreter<'ir> {
         &self.command
     }
 
-    /// Set a `reads` buffer (by its index in the controller's `reads`).
+    /// Set a `reads` buffer (by its index in the controller's `reads`):
+    /// its writer writes it, a new generation (as in Global Memory).
     pub fn set_read(&mut self, index: usize, value: Value) {
         self.reads[index] = value;
+        self.read_watch[index].0 += 1;
     }
 
     pub fn reads(&self) -> &[Value] {
@@ -218,7 +225,11 @@ impl<'ir> Interpreter<'ir> {
 
     /// One control cycle (docs/semantics.md steps 1–6).
     pub fn cycle(&mut self, hooks: &mut dyn Hooks) -> CycleRecord {
-        // 1–2. Read; the handshake view of each subordinate.
+        // 1–2. Read (each `reads` buffer's generation: `B.stale_cycles`);
+        // the handshake view of each subordinate.
+        for (generation, watch) in &mut self.read_watch {
+            watch.observe(*generation);
+        }
         for s in &mut self.subs {
             s.view = s.link.observe(&s.status);
         }

@@ -273,6 +273,36 @@ pub struct Controller {
     /// §8); `None` for a controller written out.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub instance_of: Option<InstanceOf>,
+    /// Every comparison of a time with a duration (LANGUAGE.md §8 "Time"),
+    /// lowered to a comparison of a cycle counter with a threshold: how it
+    /// was written, for tables, graphs, the site and `rcsc diff`
+    /// ([`crate::pretty`] prints `text` for the expression at `span`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub written_times: Vec<WrittenTime>,
+}
+
+/// A time compared with a duration, as written and as lowered:
+/// `state_time > 5s` on a 10 ms period is `state_cycles > 500`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct WrittenTime {
+    /// The comparison's span (the lowered `Binary` expression's).
+    pub span: Span,
+    /// The duration as written, `5s` or `TIMEOUT` (filled in from the
+    /// source once the controller is lowered).
+    pub duration: String,
+    /// Whether the time is written on the left (`state_time > 5s`; else
+    /// `5s < state_time`).
+    pub time_left: bool,
+    /// The operator with the time on the left (`5s < state_time` is `>`).
+    pub op: crate::ast::BinOp,
+    pub duration_ns: u64,
+    /// The period of the controller's CPU the threshold was computed for.
+    pub period_ns: u64,
+    /// The cycle count the counter is compared with.
+    pub threshold: u64,
+    /// The duration's span, as written.
+    #[serde(skip)]
+    pub duration_span: Span,
 }
 
 /// What an instance was made from: its type, and its arguments and
@@ -718,6 +748,9 @@ pub enum ExprKind {
     /// `a[i]` with a run-time integer `i` (the second expression): out of
     /// range, the element type's zero, and the plan ends with `INDEX_RANGE`.
     IndexBy(Box<Expr>, Box<Expr>),
+    /// `B.stale_cycles` for a `reads` buffer B (LANGUAGE.md §8): cycles
+    /// since B's writer last wrote it, as `X.stale_cycles` for a subordinate.
+    BufferStale(BufferId),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -760,6 +793,10 @@ pub struct Cpu {
     /// (the manifest's `inputs:`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub inputs: Vec<BufferId>,
+    /// Whether the manifest gives this CPU's period (else it is the
+    /// documented default, [`crate::manifest::DEFAULT_PERIOD_NS`]).
+    #[serde(skip)]
+    pub period_given: bool,
 }
 
 impl Ir {

@@ -46,6 +46,8 @@ pub mod pretty;
 pub mod render;
 pub mod scenario;
 pub mod source;
+pub mod time;
+pub mod watchdog;
 pub mod yaml;
 
 pub use diagnostic::{Code, Diagnostic, Diagnostics, Severity};

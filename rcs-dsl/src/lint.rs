@@ -24,10 +24,11 @@ pub enum Lint {
     CommandEveryCycle,
     StatusNeverReported,
     IndexRange,
+    TimerResolution,
 }
 
 impl Lint {
-    pub const ALL: [Lint; 15] = [
+    pub const ALL: [Lint; 16] = [
         Lint::RuleOfTen,
         Lint::ShadowedRow,
         Lint::UnreachableState,
@@ -43,6 +44,7 @@ impl Lint {
         Lint::CommandEveryCycle,
         Lint::StatusNeverReported,
         Lint::IndexRange,
+        Lint::TimerResolution,
     ];
 
     pub fn name(self) -> &'static str {
@@ -62,6 +64,7 @@ impl Lint {
             Lint::CommandEveryCycle => "command_every_cycle",
             Lint::StatusNeverReported => "status_never_reported",
             Lint::IndexRange => "index_range",
+            Lint::TimerResolution => "timer_resolution",
         }
     }
 

@@ -39,6 +39,8 @@ pub struct CpuSpec {
     pub name: String,
     pub span: Span,
     pub period_ns: u64,
+    /// Whether `period:` is given (else `period_ns` is the default).
+    pub period_given: bool,
     pub order: Vec<(String, Span)>,
     /// `process:`: the program this CPU runs in (`None`: the default
     /// process, named after the system). See `docs/distribution.md`.
@@ -272,6 +274,7 @@ pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>>
                 name: cpu.cpu.value.clone(),
                 span,
                 period_ns,
+                period_given: cpu.period.is_some(),
                 order: cpu
                     .order
                     .iter()

@@ -27,6 +27,35 @@ impl<'a> Printer<'a> {
         s
     }
 
+    /// The comparison `e` was written as, if it is a time compared with a
+    /// duration (`lower::time`).
+    fn written_time(&self, e: &Expr) -> Option<&'a WrittenTime> {
+        if !matches!(e.kind, ExprKind::Binary(..)) || self.ctrl.written_times.is_empty() {
+            return None;
+        }
+        self.ctrl.written_times.iter().find(|w| w.span == e.span)
+    }
+
+    /// `state_time > 5s` for a comparison lowered to `state_cycles > 500`:
+    /// the time named from its counter (`X.stale_time`, with the buffer or
+    /// subordinate this controller binds), the duration and the order as
+    /// written.
+    pub fn written_text(&self, w: &WrittenTime, counter: &Expr) -> String {
+        let time = match &counter.kind {
+            ExprKind::StateCycles => "state_time".to_string(),
+            ExprKind::PlanCycles => "plan_time".to_string(),
+            ExprKind::Sub(c, _) => format!("{}.stale_time", self.ir.controller(*c).name),
+            ExprKind::BufferStale(b) => format!("{}.stale_time", self.ir.buffers[b.index()].name),
+            _ => self.expr(counter),
+        };
+        if w.time_left {
+            format!("{time} {} {}", w.op.symbol(), w.duration)
+        } else {
+            let op = crate::time::flipped(w.op);
+            format!("{} {} {time}", w.duration, op.symbol())
+        }
+    }
+
     fn strength(e: &Expr) -> u8 {
         match &e.kind {
             ExprKind::Binary(op, ..) => op.precedence(),
@@ -43,6 +72,14 @@ impl<'a> Printer<'a> {
         let paren = Self::strength(e) < min;
         if paren {
             out.push('(');
+        }
+        // A time compared with a duration, lowered to cycles: as written.
+        if let (Some(w), ExprKind::Binary(_, operands)) = (self.written_time(e), &e.kind) {
+            out.push_str(&self.written_text(w, &operands[0]));
+            if paren {
+                out.push(')');
+            }
+            return;
         }
         match &e.kind {
             ExprKind::Int(v) => out.push_str(&v.to_string()),
@@ -70,6 +107,10 @@ impl<'a> Printer<'a> {
             }
             ExprKind::NewCommand => out.push_str("new_command"),
             ExprKind::StateCycles => out.push_str("state_cycles"),
+            ExprKind::BufferStale(b) => {
+                out.push_str(&self.ir.buffers[b.index()].name);
+                out.push_str(".stale_cycles");
+            }
             ExprKind::PlanCycles => out.push_str("plan_cycles"),
             ExprKind::CmdParam(c, p) => {
                 out.push_str("cmd.");

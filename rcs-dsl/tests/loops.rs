@@ -107,8 +107,8 @@ impl<'ir> Rig<'ir> {
                     .d
                     .set_hook(&self.ctrl.hooks[h.index()].name, v)
                     .unwrap(),
-                // `stale_cycles` is 0: every subordinate writes each cycle.
-                Leaf::SubStale(_) => assert_eq!(*v, Value::Int(0)),
+                // `stale_cycles` is 0: every subordinate (and buffer) writes each cycle.
+                Leaf::SubStale(_) | Leaf::BufStale(_) => assert_eq!(*v, Value::Int(0)),
                 Leaf::Var(..) => {} // vars no job assigns: their initial value
                 Leaf::SubField(..) | Leaf::SubErrorCode(_) => {
                     unreachable!("the generated plans read no status field nor error code")

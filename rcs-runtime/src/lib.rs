@@ -204,6 +204,7 @@ mod seqlock;
 pub mod serde_array;
 pub mod signal;
 pub mod trace;
+pub mod watchdog;
 
 #[cfg(any(feature = "zenoh", feature = "certs"))]
 pub use acl::{Security, TlsFiles};
@@ -233,6 +234,7 @@ pub use schema::Schema;
 pub use serde;
 pub use signal::CycleSignal;
 pub use trace::{read_trace, TraceError, TraceHeader, TraceRecord, TraceSink, TRACE_VERSION};
+pub use watchdog::BufferWatch;
 
 /// Include the Rust code `rcsc` generated for a plan set from a build script.
 ///

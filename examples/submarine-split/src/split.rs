@@ -34,7 +34,7 @@ const USAGE: &str = "usage: submarine-split helm|engine|one-process (--certs DIR
                and the access-control policy rcsc generated for the process
   --insecure   no TLS, no access control (tcp/ endpoints): anyone on the network can command the ship
   --cycles N   stop after N cycles (default: run until killed; one-process: 2000)
-  --report-every N  also print a `report` line every N cycles: the helm the ship's speed,
+  --report-every N  also print a `report` line every N cycles: the helm the ship's speed and age,
                the engine the turbine's drive, both the bridge's refused samples
   --report-generations
                check every cycle that the stamps of the buffers the bridge imports never go
@@ -393,9 +393,11 @@ fn helm(opts: &Options) -> Result<bool, String> {
         }
         if opts.report_every.is_some_and(|n| cycle.is_multiple_of(n)) {
             let ship = system.pr().map_or(0.0, |c| c.data().reads.ship.speed);
+            // `ship.stale_cycles` as PR saw it this cycle (its `ship_age`).
+            let ship_stale = system.pr().map_or(0, |c| c.data().vars.ship_age);
             let stats = bridge.stats();
             println!(
-                "report cycle={cycle} speed={ship:.2} tb_stale={stale} received={} imported={} refused={}",
+                "report cycle={cycle} speed={ship:.2} tb_stale={stale} ship_stale={ship_stale} received={} imported={} refused={}",
                 stats.received, stats.imported, stats.refused
             );
         }

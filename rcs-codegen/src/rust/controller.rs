@@ -323,6 +323,8 @@ pub(crate) fn module(
         Some(_) => Wiring::new(ir, names, ci).of_instance(&quote!(inst)),
         None => Wiring::new(ir, names, ci),
     };
+    let watch = super::watchdog::Watches::new(c, &read_fields, &read_handles);
+    let (watch_fields, read_stmts) = (&watch.fields, &watch.reads);
     // A `reads`/`writes` declaration's doc comment, else the buffer's name.
     let buffer_docs = |list: &[BufferId]| -> Vec<TokenStream> {
         list.iter()
@@ -704,6 +706,7 @@ pub(crate) fn module(
                 command_in: rt::Reader<rt::CommandBuffer<Command>>,
                 status_out: rt::Writer<rt::StatusBuffer>,
                 #(#read_handles: rt::Reader<#read_tys>,)*
+                #(#watch_fields: rt::BufferWatch,)*
                 #(#write_handles: rt::Writer<#write_tys>,)*
                 #(#sub_handles: rt::Subordinate<super::#sub_modules::Command>,)*
                 #every_cycle_handles
@@ -726,6 +729,7 @@ pub(crate) fn module(
                         status_out: gm.status_writer(#gm_name)?,
                         #inst_init
                         #(#read_handles: gm.reader(#read_names)?,)*
+                        #(#watch_fields: rt::BufferWatch::new(),)*
                         #(#write_handles: gm.writer(#write_names)?,)*
                         #(#sub_handles: rt::Subordinate::connect(gm, #sub_names)?,)*
                         #every_cycle_inits
@@ -772,7 +776,7 @@ pub(crate) fn module(
                 fn cycle(&mut self, ctx: &rt::CycleContext) {
                     #step1
                     let command = self.command_in.read().value;
-                    #(self.data.reads.#read_fields = self.#read_handles.read().value;)*
+                    #(#read_stmts)*
                     #sub_fields_read
                     #step2
                     let subs = Subs { #(#sub_fields: self.#sub_handles.read()),* };

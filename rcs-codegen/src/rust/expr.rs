@@ -344,6 +344,14 @@ impl Gen<'_> {
             }
             ExprKind::IndexBy(base, i) => self.index_by(base, i, &e.ty),
             ExprKind::Call(h, args) => self.call(*h, args),
+            // The controller's watch on the buffer, fed by each cycle's read.
+            ExprKind::BufferStale(b) => {
+                let id = self.cn().buffers[b.index()]
+                    .as_ref()
+                    .expect("buffer of this controller");
+                let watch = crate::ident::prefixed("watch", id);
+                Code::atom(quote!(self.#watch.stale_cycles()))
+            }
             ExprKind::Sub(c, prop) => {
                 let i = self.ctrl.subordinate_index(*c).expect("a subordinate");
                 let id = &self.cn().subs[i];

@@ -414,7 +414,7 @@ impl Cmp<'_> {
             (K::CmdParam(c, p), K::CmdParam(d, q)) => c == d && p == q,
             (K::CurrentParam(a), K::CurrentParam(b)) => a == b,
             (K::Var(i), K::Var(j)) => i == j,
-            (K::Buffer(i), K::Buffer(j)) => {
+            (K::Buffer(i), K::Buffer(j)) | (K::BufferStale(i), K::BufferStale(j)) => {
                 Self::buffer_pos(self.a, *i).is_some()
                     && Self::buffer_pos(self.a, *i) == Self::buffer_pos(self.b, *j)
             }

@@ -19,6 +19,7 @@ mod schema;
 mod system;
 mod types;
 mod verbs;
+mod watchdog;
 
 use crate::GENERATED;
 use proc_macro2::TokenStream;

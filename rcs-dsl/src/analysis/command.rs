@@ -474,7 +474,8 @@ impl PlanAnalysis<'_> {
                     Leaf::StateCycles
                     | Leaf::PlanCycles
                     | Leaf::SubStale(_)
-                    | Leaf::SubErrorCode(_) => true,
+                    | Leaf::SubErrorCode(_)
+                    | Leaf::BufStale(_) => true,
                     Leaf::NewCommand
                     | Leaf::Param(..)
                     | Leaf::Call(..)

@@ -200,7 +200,8 @@ fn out_formula(
         | Leaf::Call(..)
         | Leaf::StateCycles
         | Leaf::PlanCycles
-        | Leaf::SubStale(_) => true,
+        | Leaf::SubStale(_)
+        | Leaf::BufStale(_) => true,
         Leaf::Buffer(b, _) => ctrl.reads.contains(&b),
         Leaf::Var(v, _) => !assigned.contains(&v),
         Leaf::NewCommand | Leaf::SubStatus(_) | Leaf::SubErrorCode(_) => false,

@@ -582,6 +582,7 @@ impl<'ir> PlanAnalysis<'ir> {
             Leaf::SubStatus(c) => format!("{}.status", sub(*c)),
             Leaf::SubStale(c) => format!("{}.{}", sub(*c), SubProp::StaleCycles.name()),
             Leaf::SubErrorCode(c) => format!("{}.{}", sub(*c), SubProp::ErrorCode.name()),
+            Leaf::BufStale(b) => format!("{}.stale_cycles", self.ir.buffers[b.index()].name),
             Leaf::Call(h, args) => printer.expr(&Expr {
                 kind: ExprKind::Call(*h, args.clone()),
                 ty: self.ctrl.hooks[h.index()].ret.clone(),

@@ -410,7 +410,8 @@ impl PlanAnalysis<'_> {
                 }
                 Leaf::Var(v, steps) => scene.vars.get(v.index()).and_then(|v| at_path(v, steps)),
                 // A scenario writes every status each cycle: never stale.
-                Leaf::SubStale(_) => Some(Value::Int(0)),
+                // …and every `reads` buffer (no `silent:` in a witness).
+                Leaf::SubStale(_) | Leaf::BufStale(_) => Some(Value::Int(0)),
                 Leaf::Buffer(b, steps) if !self.ctrl.reads.contains(b) => self
                     .ctrl
                     .writes

@@ -33,6 +33,9 @@ pub enum Leaf {
     /// `X.error_code` (§8): an input the analysis does not model; an atom
     /// that reads it is left undecided.
     SubErrorCode(CtrlId),
+    /// A `reads` buffer's `stale_cycles` (LANGUAGE.md §8): a free input,
+    /// as a subordinate's.
+    BufStale(crate::ir::BufferId),
     /// A subordinate's status field (`X.NAME`), then constant projections:
     /// an input the subordinate sets freely, like a `reads` buffer.
     SubField(CtrlId, VarId, Vec<Step>),
@@ -312,7 +315,8 @@ pub fn is_leaf(e: &Expr) -> bool {
         | ExprKind::StateCycles
         | ExprKind::PlanCycles
         | ExprKind::Call(..)
-        | ExprKind::Sub(..) => true,
+        | ExprKind::Sub(..)
+        | ExprKind::BufferStale(_) => true,
         _ => is_place_leaf(e),
     }
 }
@@ -342,6 +346,7 @@ pub fn as_leaf(e: &Expr) -> Option<Leaf> {
         ExprKind::Sub(c, SubProp::StaleCycles) => Leaf::SubStale(*c),
         ExprKind::Sub(c, SubProp::ErrorCode) => Leaf::SubErrorCode(*c),
         ExprKind::Sub(c, _) => Leaf::SubStatus(*c),
+        ExprKind::BufferStale(b) => Leaf::BufStale(*b),
         ExprKind::CmdParam(_, p) => Leaf::Param(*p, Vec::new()),
         ExprKind::Var(v) => Leaf::Var(*v, Vec::new()),
         ExprKind::Buffer(b) => Leaf::Buffer(*b, Vec::new()),
@@ -397,6 +402,7 @@ fn same_leaf_as(e: &Expr, leaf: &Leaf) -> bool {
         }
         (ExprKind::Sub(c, SubProp::StaleCycles), Leaf::SubStale(d)) => c == d,
         (ExprKind::Sub(c, SubProp::ErrorCode), Leaf::SubErrorCode(d)) => c == d,
+        (ExprKind::BufferStale(b), Leaf::BufStale(d)) => b == d,
         (ExprKind::Sub(c, p), Leaf::SubStatus(d)) => {
             !matches!(p, SubProp::StaleCycles | SubProp::ErrorCode) && c == d
         }
@@ -446,6 +452,7 @@ pub fn same_leaf(a: &Leaf, b: &Leaf) -> bool {
             h == k && xs.len() == ys.len() && xs.iter().zip(ys).all(|(x, y)| same_expr(x, y))
         }
         (Leaf::SubStatus(x), Leaf::SubStatus(y)) | (Leaf::SubStale(x), Leaf::SubStale(y)) => x == y,
+        (Leaf::BufStale(x), Leaf::BufStale(y)) => x == y,
         _ => false,
     }
 }

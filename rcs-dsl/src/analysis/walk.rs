@@ -132,7 +132,9 @@ impl<'a, 'ir> Walker<'a, 'ir> {
                 Leaf::Var(..) if !constant_vars.iter().any(|(l, _)| *l == id) => return None,
                 Leaf::Buffer(b, _) if ctrl.writes.contains(b) => return None,
                 Leaf::SubStatus(x) => statuses.push((*x, id)),
-                Leaf::SubStale(_) => constant.push((id, Value::Int(0))),
+                // Every status and `reads` buffer is written each cycle
+                // in the runs the walk builds: never stale.
+                Leaf::SubStale(_) | Leaf::BufStale(_) => constant.push((id, Value::Int(0))),
                 _ => {}
             }
         }

@@ -13,6 +13,7 @@ mod loops;
 pub(crate) mod names;
 mod plan;
 mod report;
+mod time;
 mod usage;
 
 use crate::analysis::PlanAnalysis;
@@ -30,6 +31,14 @@ pub(crate) struct Sink<'a> {
 impl Sink<'_> {
     pub fn error(&mut self, d: Diagnostic) {
         self.diags.push(d);
+    }
+
+    /// A note under a lint's code inside `ctrl`: shown unless the lint is
+    /// allowed there, and never more than a note (it states a fact).
+    pub fn note(&mut self, ctrl: &Controller, lint: Lint, d: Diagnostic) {
+        if self.levels.at(lint, &[&ctrl.lints]) != crate::lint::Level::Allow {
+            self.diags.push(d);
+        }
     }
 
     /// A lint finding inside `ctrl` (and `plan`, if any); attributes there apply.
@@ -184,6 +193,7 @@ fn analyse_controller<'ir>(ir: &'ir Ir, ci: CtrlId, levels: &LintLevels) -> Anal
         check_plan(ir, c, p, conditions, analysis, &mut sink);
     }
     usage::check_float_equality(c, &mut sink);
+    time::check_timer_resolution(ir, ci, &mut sink);
     let uses = usage::check_unused_in_controller(ir, ci, &mut sink);
     let summary = handshake::Summary::of(c, &conditions, &graphs);
     // Only the handshake checks read the analyses again, and only those of

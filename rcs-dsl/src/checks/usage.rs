@@ -75,7 +75,7 @@ pub(crate) fn check_unused_in_controller(ir: &Ir, ci: CtrlId, sink: &mut Sink) -
         match &e.kind {
             ExprKind::Var(v) => var_used[v.index()] = true,
             ExprKind::Call(h, _) => hook_used[h.index()] = true,
-            ExprKind::Buffer(b) => buffer_used[b.index()] = true,
+            ExprKind::Buffer(b) | ExprKind::BufferStale(b) => buffer_used[b.index()] = true,
             ExprKind::Variant(en, _) => uses.enums.push(*en),
             _ => {}
         }

@@ -91,6 +91,15 @@ impl Interpreter<'_> {
                 }
                 v
             }
+            ExprKind::BufferStale(b) => {
+                let i = self
+                    .ctrl
+                    .reads
+                    .iter()
+                    .position(|r| r == b)
+                    .expect("a read buffer");
+                Value::Int(i128::from(self.read_watch[i].1.stale_cycles()))
+            }
             ExprKind::Sub(c, prop) => {
                 let i = self.ctrl.subordinate_index(*c).expect("a subordinate");
                 let v = self.subs[i].view;

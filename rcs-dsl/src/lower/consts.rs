@@ -38,6 +38,77 @@ pub(crate) struct Const {
 pub(crate) struct ConstTable {
     file: BTreeMap<String, Const>,
     ctrl: Vec<BTreeMap<String, Const>>,
+    /// `const NAME: duration = 50ms` (LANGUAGE.md §8): nanoseconds. Kept
+    /// apart, since a duration is no run-time value (see `lower::time`).
+    pub durations: Durations,
+}
+
+/// The `duration` constants, file level and per controller.
+#[derive(Clone, Default)]
+pub(crate) struct Durations {
+    file: BTreeMap<String, u64>,
+    ctrl: Vec<BTreeMap<String, u64>>,
+}
+
+impl Durations {
+    /// The duration constant `name` as seen from controller `ctrl` (its
+    /// own first, then the file's), in nanoseconds.
+    pub fn get(&self, ctrl: Option<usize>, name: &str) -> Option<u64> {
+        ctrl.and_then(|c| self.ctrl.get(c))
+            .and_then(|m| m.get(name))
+            .or_else(|| self.file.get(name))
+            .copied()
+    }
+}
+
+/// Whether a constant is declared `: duration` (no user type may take the
+/// name: it is not among the primitive types, so an enum or buffer called
+/// `duration` is still read as one).
+fn is_duration(def: &ast::ConstDef, g: &Globals) -> bool {
+    matches!(&def.ty, ast::TypeExpr::Named(n) if n.text == "duration")
+        && !g.names.contains_key("duration")
+}
+
+/// Fold the `duration` constants: each is a duration literal (in
+/// parentheses or not); anything else is reported.
+fn fold_durations(
+    g: &Globals,
+    defs: &BTreeMap<(Scope, String), &ast::ConstDef>,
+    diags: &mut Diagnostics,
+) -> Durations {
+    let mut out = Durations {
+        file: BTreeMap::new(),
+        ctrl: vec![BTreeMap::new(); g.controllers.len()],
+    };
+    for ((scope, name), def) in defs {
+        if !is_duration(def, g) {
+            continue;
+        }
+        let mut e = &def.value;
+        while let ast::ExprKind::Paren(x) = &e.kind {
+            e = x;
+        }
+        let ns = match &e.kind {
+            ast::ExprKind::Duration(ns) => *ns,
+            _ => {
+                diags.push(
+                    Diagnostic::error(
+                        Code::TypeMismatch,
+                        format!("duration constant `{name}` must be a duration literal"),
+                        def.value.span,
+                        "not a duration literal",
+                    )
+                    .with_help("write it with a unit: `50ms`, `1.5s`, `250us`"),
+                );
+                0
+            }
+        };
+        match scope {
+            Some(i) => out.ctrl[*i].insert(name.clone(), ns),
+            None => out.file.insert(name.clone(), ns),
+        };
+    }
+    out
 }
 
 impl ConstTable {
@@ -84,12 +155,16 @@ pub(super) fn fold_all(g: &Globals, diags: &mut Diagnostics) -> ConstTable {
             }
         }
     }
+    let durations = fold_durations(g, &defs, diags);
+    defs.retain(|_, d| !is_duration(d, g));
     let mut f = Folder {
         g,
         defs,
+        durations: durations.clone(),
         table: ConstTable {
             file: BTreeMap::new(),
             ctrl: vec![BTreeMap::new(); g.controllers.len()],
+            durations,
         },
         done: BTreeMap::new(),
         busy: Vec::new(),
@@ -113,6 +188,7 @@ pub(super) fn array_len(
     let mut f = Folder {
         g,
         defs: BTreeMap::new(),
+        durations: g.consts_table.durations.clone(),
         table: ConstTable::default(),
         done: BTreeMap::new(),
         busy: Vec::new(),
@@ -151,6 +227,8 @@ struct Folder<'a, 'g> {
     /// Definitions not folded yet (empty when folding an array length:
     /// every constant is in `g.consts_table` by then).
     defs: BTreeMap<(Scope, String), &'g ast::ConstDef>,
+    /// The `duration` constants, to say so when a number uses one.
+    durations: Durations,
     table: ConstTable,
     /// Folded definitions: `false` for those with an error.
     done: BTreeMap<(Scope, String), bool>,

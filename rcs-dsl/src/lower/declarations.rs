@@ -7,6 +7,7 @@ use super::{duplicate, resolve_type, resolve_type_in, ByName, Globals};
 use crate::ast;
 use crate::diagnostic::{Code, Diagnostic, Diagnostics};
 use crate::ir::*;
+use crate::manifest::DEFAULT_PERIOD_NS;
 use crate::source::Span;
 
 /// Pass 1 for every controller: commands, statuses, errors, vars, hooks.
@@ -262,6 +263,7 @@ pub(super) fn lower_controller_body(
     let mut plans: Vec<Plan> = Vec::new();
     let (mut pre, mut post): (Option<EveryCycle>, Option<EveryCycle>) = (None, None);
     let mut plan_of: Vec<Option<PlanId>> = vec![None; ir.controllers[id.index()].commands.len()];
+    let written_times;
     {
         let ctrl = &ir.controllers[id.index()];
         // Hooks whose declared return type did not resolve (already reported).
@@ -289,6 +291,13 @@ pub(super) fn lower_controller_body(
             diags,
             plan_verbs: Vec::new(),
             accept_ctx: false,
+            time: super::time::TimeCx {
+                period_ns: g
+                    .periods
+                    .get(ctrl.name.as_str())
+                    .map_or(DEFAULT_PERIOD_NS, |(p, _)| *p),
+                written: Vec::new(),
+            },
         };
         for e in &c.entries {
             match &e.kind {
@@ -376,6 +385,7 @@ pub(super) fn lower_controller_body(
                 _ => {}
             }
         }
+        written_times = std::mem::take(&mut cx.time.written);
     }
     ControllerBody {
         inits,
@@ -385,6 +395,7 @@ pub(super) fn lower_controller_body(
         pre,
         post,
         diags: std::mem::take(diags),
+        written_times,
     }
 }
 
@@ -403,6 +414,8 @@ pub(super) struct ControllerBody {
     pre: Option<EveryCycle>,
     post: Option<EveryCycle>,
     pub diags: Diagnostics,
+    /// Comparisons of times with durations (`lower::time`).
+    pub(super) written_times: Vec<WrittenTime>,
 }
 
 impl ControllerBody {
@@ -419,5 +432,6 @@ impl ControllerBody {
         ctrl.plans = self.plans;
         ctrl.pre = self.pre;
         ctrl.post = self.post;
+        ctrl.written_times = self.written_times;
     }
 }

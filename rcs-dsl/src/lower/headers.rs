@@ -45,6 +45,7 @@ pub(super) fn lower_controller_headers<'a>(
             buffer_docs: Vec::new(),
             pre: None,
             post: None,
+            written_times: Vec::new(),
             instance_of: c.instance.as_ref().map(|i| crate::ir::InstanceOf {
                 ty: i.ty.text.to_string(),
                 type_span: i.type_span,

@@ -16,6 +16,7 @@ mod index;
 mod plans;
 mod schedule;
 mod state_sets;
+mod time;
 mod types;
 mod verbs;
 pub use expr::type_name;
@@ -51,6 +52,8 @@ pub(crate) struct Globals<'a> {
     pub consts: Vec<&'a ast::ConstDef>,
     /// Every constant's value, once folded (right after the enums).
     pub consts_table: consts::ConstTable,
+    /// Each controller's CPU period and whether the manifest gives it.
+    pub periods: BTreeMap<String, (u64, bool)>,
     /// The controller whose declarations are being lowered, if any: the
     /// scope of constants in array lengths. Set only by the sequential
     /// passes; controller bodies, lowered in parallel, name their scope
@@ -134,6 +137,7 @@ pub fn lower(
     };
     lower_enums(&globals, &mut ir, diags);
     globals.consts_table = consts::fold_all(&globals, diags);
+    globals.periods = schedule::periods(manifest);
     lower_buffer_types(&globals, &mut ir, diags);
     check_buffer_recursion(&ir, diags);
     let ctrl_asts = lower_controller_headers(&globals, &mut ir, sources, diags);
@@ -162,6 +166,7 @@ pub fn lower(
     let bodies = crate::parallel::map_pinned(&ids, &workers, rows >= 2048, |(id, c, rows)| {
         let rows = std::mem::take(&mut *rows.lock().unwrap_or_else(|e| e.into_inner()));
         let mut body = declarations::lower_controller_body(&globals, &names, &ir, *id, c, rows);
+        time::fill_texts(&mut body.written_times, sources);
         // Each row's line, for generated comments: looked up here, on the
         // worker, rather than for the whole set on one thread afterwards.
         for row in body.plans.iter_mut().flat_map(|p| &mut p.rows) {
@@ -259,6 +264,7 @@ fn collect_items<'a>(files: &'a [ast::File], diags: &mut Diagnostics) -> Globals
         controllers: Vec::new(),
         consts: Vec::new(),
         consts_table: consts::ConstTable::default(),
+        periods: BTreeMap::new(),
         scope: ScopeCell::default(),
     };
     let mut const_names = ByName::default();

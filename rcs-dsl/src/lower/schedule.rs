@@ -26,6 +26,7 @@ pub(super) fn lower_schedule(ir: &Ir, m: &Manifest, diags: &mut Diagnostics) -> 
             order,
             process: None,
             inputs: Vec::new(),
+            period_given: false,
         }];
     };
     let mut placed: Vec<Option<Span>> = vec![None; ir.controllers.len()];
@@ -75,6 +76,7 @@ pub(super) fn lower_schedule(ir: &Ir, m: &Manifest, diags: &mut Diagnostics) -> 
             order,
             process: spec.process.as_ref().map(|p| p.0.clone()),
             inputs: Vec::new(),
+            period_given: spec.period_given,
         });
     }
     let missing: Vec<&str> = ir
@@ -120,4 +122,21 @@ fn preorder(ir: &Ir, root: CtrlId, out: &mut Vec<CtrlId>, seen: &mut [bool]) {
         out.push(id);
         stack.extend(ir.controllers[id.index()].subordinates.iter().rev());
     }
+}
+
+/// The period each controller's CPU runs at, by controller name, and
+/// whether the manifest gives it: read from the manifest before the
+/// controllers are lowered, since `state_time > 5s` is lowered to cycles
+/// of that period (`lower::time`). A controller no CPU names (an error
+/// reported with the schedule) and every controller of a set without a
+/// schedule take the default.
+pub(super) fn periods(m: &Manifest) -> BTreeMap<String, (u64, bool)> {
+    let mut out = BTreeMap::new();
+    for spec in m.schedule.iter().flatten() {
+        for (name, _) in &spec.order {
+            out.entry(name.clone())
+                .or_insert((spec.period_ns, spec.period_given));
+        }
+    }
+    out
 }

@@ -126,11 +126,13 @@ pub(crate) fn resolve_type_in(
                             n.span,
                             "not declared",
                         )
-                        .with_help(format!(
+                        .with_help(if n.text == "duration" {
+                            "`duration` is the type of constants only (`const T: duration = 50ms`), compared with a time: `state_time > T`; a var counts cycles instead (`u32`)".to_string()
+                        } else { format!(
                             "declare it with `enum {0} {{ … }}` or `buffer {0} {{ … }}`, or use one of {1}",
                             n.text,
                             PRIMITIVES.join(", ")
-                        )),
+                        ) }),
                     );
                     None
                 }

@@ -118,8 +118,35 @@ pub(super) fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>
             "a command is refused unless `accept when COND` holds: write `command VERB(…) accept when COND`",
         );
     }
+    // `5 s`, `50 ms`: a duration's unit must touch its number (§8).
+    let word: String = text[pos.min(text.len())..]
+        .chars()
+        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+        .collect();
+    let number_before = before.len() < pos
+        && before.ends_with(|c: char| c.is_ascii_digit())
+        && before
+            .trim_end_matches(|c: char| c.is_ascii_digit() || c == '_' || c == '.')
+            .ends_with(|c: char| !(c.is_ascii_alphanumeric() || c == '_'));
+    let spaced_unit = number_before
+        && crate::time::UNITS
+            .iter()
+            .any(|(u, _)| *u == word || matches!(word.as_str(), "sec" | "secs" | "msec"));
     if spaced_postfix {
         diagnostic.with_help("write calls, fields, indices and `Enum::Variant` without spaces: `h()`, `ship.speed`, `a[0]`")
+    } else if spaced_unit {
+        let number = before
+            .rsplit(|c: char| !(c.is_ascii_digit() || c == '_' || c == '.'))
+            .next()
+            .unwrap_or("");
+        let unit = if crate::time::UNITS.iter().any(|(u, _)| *u == word) {
+            word.as_str()
+        } else {
+            "s"
+        };
+        diagnostic.with_help(format!(
+            "write a duration's unit right after its number, without a space: `{number}{unit}`"
+        ))
     } else {
         diagnostic
     }

@@ -101,6 +101,9 @@ struct Step {
     reads: Vec<(usize, Json)>,
     hooks: Vec<(HookId, Value)>,
     subs: Vec<(usize, SubSetting)>,
+    /// `silent: [B, …]`: `reads` buffers (by index) held unwritten from
+    /// this step's first cycle until a later step's `reads:` writes them.
+    silent: Vec<usize>,
     /// `initial:` only: vars and `writes` buffers (merged into zero).
     vars: Vec<(usize, Value)>,
     writes: Vec<(usize, Json)>,

@@ -41,6 +41,8 @@ struct RawStep {
     reads: Option<Entries>,
     hooks: Option<Entries>,
     subordinates: Option<Entries>,
+    /// `silent: [B, …]`: `reads` buffers held unwritten (LANGUAGE.md §8).
+    silent: Option<Spanned<Json>>,
     cycles: Option<Spanned<Json>>,
     expect: Option<RawExpect>,
 }
@@ -145,7 +147,8 @@ pub fn parse(ir: &Ir, file: &SourceFile, stem: &str) -> Result<Scenario, Scenari
     for s in raw.steps {
         let line = line_of(&s);
         let v = s.value;
-        steps.push(r.step(
+        let silent = v.silent.as_ref().map(|s| r.silent(s)).transpose()?;
+        let mut step = r.step(
             line,
             v.command,
             v.reads,
@@ -153,7 +156,18 @@ pub fn parse(ir: &Ir, file: &SourceFile, stem: &str) -> Result<Scenario, Scenari
             v.subordinates,
             v.cycles,
             v.expect,
-        )?);
+        )?;
+        if let Some((at, silent)) = silent {
+            if let Some((i, _)) = step.reads.iter().find(|(i, _)| silent.contains(i)) {
+                let name = &ir.buffers[r.c.reads[*i].index()].name;
+                return Err(err(
+                    at,
+                    format!("`{name}` is both written (`reads:`) and `silent:` in one step; write it again in a later step"),
+                ));
+            }
+            step.silent = silent;
+        }
+        steps.push(step);
     }
     Ok(Scenario {
         name: raw.name.unwrap_or_else(|| stem.to_string()),
@@ -223,11 +237,50 @@ impl Resolver<'_> {
             reads: read_list,
             hooks: hook_list,
             subs: sub_list,
+            silent: Vec::new(),
             vars: Vec::new(),
             writes: Vec::new(),
             cycles: cycles.map_or(Ok(1), |c| self.cycles(&c))?,
             expect,
         })
+    }
+
+    /// `silent: [B, …]`: the `reads` buffers named, by index in `reads`,
+    /// with the line of the key.
+    fn silent(&self, v: &Spanned<Json>) -> Result<(usize, Vec<usize>), ScenarioError> {
+        let line = line_of(v);
+        let shape = || {
+            err(
+                line,
+                "`silent` is a list of `reads` buffers held unwritten: `silent: [io]`",
+            )
+        };
+        let names: Vec<&str> = match &v.value {
+            Json::Array(xs) => xs
+                .iter()
+                .map(|x| x.as_str().ok_or_else(shape))
+                .collect::<Result<_, _>>()?,
+            Json::String(s) => vec![s.as_str()],
+            _ => return Err(shape()),
+        };
+        let mut out = Vec::new();
+        for name in names {
+            let i = self
+                .c
+                .reads
+                .iter()
+                .position(|b| self.ir.buffers[b.index()].name == name)
+                .ok_or_else(|| {
+                    let hint = if self.ir.controller_by_name(name).is_some() {
+                        format!("; a subordinate is held with `subordinates: {{ {name}: {{ silent: true }} }}`")
+                    } else {
+                        String::new()
+                    };
+                    err(line, format!("`{}` reads no buffer `{name}`{hint}", self.c.name))
+                })?;
+            out.push(i);
+        }
+        Ok((line, out))
     }
 
     /// `cycles: N`, 1 to [`MAX_CYCLES`].

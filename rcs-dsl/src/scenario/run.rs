@@ -102,6 +102,12 @@ fn drive(
             shown: 0,
         })
         .collect();
+    // Watched `reads` buffers (`B.stale_cycles`) are rewritten before every
+    // cycle, as a live writer does, unless `silent:` holds them; buffers
+    // nobody watches are written only when a step sets them (no one can
+    // tell the difference, and it costs a backend call per cycle).
+    let watched = crate::watchdog::watched_reads(c);
+    let mut held = vec![false; c.reads.len()];
     let mut hook_calls = vec![0u64; c.hooks.len()];
     let mut hook_args: Vec<(u16, Vec<Value>)> = Vec::new();
     // The serial of the latest command the scenario sent (0: none).
@@ -120,6 +126,10 @@ fn drive(
                 .map_err(|e| (e.line, e.message))?;
             d.set_read(&b.name, &merged).map_err(fail)?;
             reads[*i] = merged;
+            held[*i] = false;
+        }
+        for i in &step.silent {
+            held[*i] = true;
         }
         for (h, v) in &step.hooks {
             d.set_hook(&c.hooks[h.index()].name, v).map_err(fail)?;
@@ -169,6 +179,12 @@ fn drive(
             .collect();
         let mut last: Option<Record> = None;
         for n in 0..step.cycles {
+            for (i, value) in reads.iter().enumerate() {
+                if watched[i] && !held[i] {
+                    let b = &ir.buffers[c.reads[i].index()];
+                    d.set_read(&b.name, value).map_err(fail)?;
+                }
+            }
             for (i, sub) in subs.iter_mut().enumerate() {
                 if sub.setting.silent {
                     continue;

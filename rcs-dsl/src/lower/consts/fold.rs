@@ -88,8 +88,15 @@ impl Folder<'_, '_> {
                 }),
             },
             ast::ExprKind::Bool(b) => Some(known(Value::Bool(*b), Type::Bool)),
-            ast::ExprKind::NewCommand | ast::ExprKind::StateCycles | ast::ExprKind::PlanCycles => {
-                self.not_constant(e.span, "a plan quantity")
+            ast::ExprKind::NewCommand
+            | ast::ExprKind::StateCycles
+            | ast::ExprKind::PlanCycles
+            | ast::ExprKind::StateTime
+            | ast::ExprKind::PlanTime => self.not_constant(e.span, "a plan quantity"),
+            ast::ExprKind::Duration(_) => {
+                self.diags
+                    .push(super::super::time::duration_not_number(e.span, hint));
+                None
             }
             ast::ExprKind::CmdParam(_) => self.not_constant(e.span, "a command parameter"),
             ast::ExprKind::Field(..) => self.not_constant(e.span, "a field"),
@@ -187,6 +194,11 @@ impl Folder<'_, '_> {
     }
 
     fn name(&mut self, scope: Scope, n: &ast::Name, hint: Option<&Type>) -> Option<Folded> {
+        if self.durations.get(scope, &n.text).is_some() {
+            self.diags
+                .push(super::super::time::duration_not_number(n.span, hint));
+            return None;
+        }
         let mut key = (scope, n.text.to_string());
         if scope.is_some() && !self.has(&key) {
             key.0 = None;

@@ -55,6 +55,8 @@ pub(in crate::lower) struct Cx<'a, 'g> {
     pub(in crate::lower) plan_verbs: Vec<CommandId>,
     /// In an `accept when` condition: no hook calls, no plan quantities.
     pub(in crate::lower) accept_ctx: bool,
+    /// The CPU period, and the comparisons of times with durations lowered.
+    pub(in crate::lower) time: super::time::TimeCx,
 }
 
 /// A lowered array index.
@@ -259,6 +261,12 @@ impl Cx<'_, '_> {
         let mk = |kind: ExprKind, ty: Type| Expr { kind, ty, span };
         match &e.kind {
             ast::ExprKind::Paren(inner) => self.infer(inner, hint),
+            ast::ExprKind::Duration(_) | ast::ExprKind::StateTime | ast::ExprKind::PlanTime => {
+                self.time_out_of_place(e)
+            }
+            ast::ExprKind::Path(None, n) if self.duration_const(&n.text).is_some() => {
+                self.time_out_of_place(e)
+            }
             ast::ExprKind::Int(v) => (
                 mk(ExprKind::Int(*v as i128), Type::Int(IntTy::I64)),
                 Ty::IntLit,

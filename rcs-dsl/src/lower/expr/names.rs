@@ -310,13 +310,14 @@ impl Cx<'_, '_> {
                         name.span,
                         "not a hook",
                     )
-                    .with_help(match crate::builtin::closest(&name.text) {
-                        Some(b) => format!(
+                    .with_help(match (super::super::time::timer_spelling(&name.text), crate::builtin::closest(&name.text)) {
+                        (Some(help), _) => help,
+                        (None, Some(b)) => format!(
                             "did you mean the built-in function `{}`? Else declare a hook: `hook {}(…) -> T`",
                             b.name(),
                             name.text
                         ),
-                        None => format!("declare it: `hook {}(…) -> T`", name.text),
+                        (None, None) => format!("declare it: `hook {}(…) -> T`", name.text),
                     }),
                 );
                 for a in args {
@@ -381,6 +382,16 @@ impl Cx<'_, '_> {
         field: &ast::Name,
         span: Span,
     ) -> (Expr, Ty) {
+        if field.text == "stale_time" {
+            let whole = ast::Expr {
+                kind: ast::ExprKind::Field(Box::new(base.clone()), field.clone()),
+                span,
+            };
+            return self.time_out_of_place(&whole);
+        }
+        if let Some(watchdog) = self.buffer_watchdog(base, field, span) {
+            return watchdog;
+        }
         // `X.prop` on a controller name: the handshake view of a subordinate.
         if let ast::ExprKind::Path(None, x) = &base.kind {
             if self.value(&x.text).is_none() || matches!(self.value(&x.text), Some(Value::Sub)) {
@@ -388,6 +399,12 @@ impl Cx<'_, '_> {
                     return self.sub_prop(*cid, x, field, span);
                 }
                 let sub_prop = ["status", "done", "executing", "error", "stale_cycles"];
+                if field.text == "stale_cycles" && self.value(&x.text).is_none() {
+                    if let Some(d) = super::super::time::unread_buffer(self, x) {
+                        self.diags.push(d);
+                        return (err_expr(span), Ty::Err);
+                    }
+                }
                 if self.value(&x.text).is_none() && sub_prop.contains(&field.text.as_str()) {
                     self.diags.push(
                         Diagnostic::error(

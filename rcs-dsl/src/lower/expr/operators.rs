@@ -87,6 +87,12 @@ impl Cx<'_, '_> {
         r: &ast::Expr,
         span: Span,
     ) -> (Expr, Ty) {
+        if op.is_comparison()
+            && (super::super::time::mentions_time(self, l)
+                || super::super::time::mentions_time(self, r))
+        {
+            return self.time_comparison(op, l, r, span);
+        }
         match op {
             BinOp::Shl | BinOp::Shr => self.shift(op, l, r, span),
             BinOp::And | BinOp::Or => {

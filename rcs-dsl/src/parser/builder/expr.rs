@@ -295,6 +295,9 @@ impl Builder {
         };
         let mut height = 1;
         let kind = match p.as_rule() {
+            Rule::number if !crate::time::split_unit(p.as_str()).1.is_empty() => {
+                self.duration_literal(p.as_str(), span)
+            }
             Rule::number
                 if !p.as_str().starts_with("0x") && p.as_str().contains(['.', 'e', 'E']) =>
             {
@@ -325,6 +328,8 @@ impl Builder {
                     ("new_command", None) => ExprKind::NewCommand,
                     ("state_cycles", None) => ExprKind::StateCycles,
                     ("plan_cycles", None) => ExprKind::PlanCycles,
+                    ("state_time", None) => ExprKind::StateTime,
+                    ("plan_time", None) => ExprKind::PlanTime,
                     // Left for `postfix`, which turns `cmd.P` into a parameter.
                     ("cmd", None) => ExprKind::Path(
                         None,
@@ -367,4 +372,78 @@ impl Builder {
 /// not a user-chosen name (so not refused as a reserved word).
 fn is_field_keyword(p: &Pair<Rule>) -> bool {
     matches!(p.as_str(), "status" | "error")
+}
+
+impl Builder {
+    /// A number with letters after it: a duration (`50ms`, `1.5s`), or a
+    /// `syntax` error that names what is wrong and shows the right spelling.
+    fn duration_literal(&mut self, text: &str, span: Span) -> ExprKind {
+        use crate::time::{parse_literal, split_unit, LiteralError};
+        let (number, unit) = split_unit(text);
+        if number == "0" && (unit.starts_with('x') || unit.starts_with('b')) {
+            let what = if unit.starts_with('x') {
+                "hex"
+            } else {
+                "binary"
+            };
+            self.error(
+                span,
+                format!("`{text}` is not a {what} literal"),
+                "no digits after the prefix",
+            );
+            self.help_last(if what == "hex" {
+                "write the digits after `0x`: `0x6F`"
+            } else {
+                "write the digits after `0b`: `0b0110_1111`"
+            });
+            return ExprKind::Int(0);
+        }
+        let (message, label, help) = match parse_literal(number, unit) {
+            Ok(ns) => return ExprKind::Duration(ns),
+            Err(LiteralError::UnknownUnit(u)) => (
+                format!("unknown unit `{u}` in `{text}`"),
+                "not a unit".to_string(),
+                match u.as_str() {
+                    "sec" | "secs" | "second" | "seconds" => format!("write `{number}s`"),
+                    "msec" | "msecs" | "millis" => format!("write `{number}ms`"),
+                    "usec" | "usecs" | "micros" | "µs" => format!("write `{number}us`"),
+                    "min" | "mins" | "minute" | "minutes" | "h" | "hour" | "hours" => {
+                        "write minutes and hours in seconds: `60s`, `3600s`".to_string()
+                    }
+                    _ => "a duration is a decimal number and a unit: `250us`, `50ms`, `1.5s` \
+                          (a number takes no letters otherwise)"
+                        .to_string(),
+                },
+            ),
+            Err(LiteralError::NotDecimal) => (
+                format!("`{text}`: a duration is written in decimal"),
+                "hex or binary duration".to_string(),
+                "write it in decimal: `16ms` (hex and binary are for integer words)".to_string(),
+            ),
+            Err(LiteralError::Exponent) => (
+                format!("`{text}`: a duration has no exponent"),
+                "exponent in a duration".to_string(),
+                "write it with a smaller unit: `1e3ms` is `1s`, `1.5e-3s` is `1.5ms`".to_string(),
+            ),
+            Err(LiteralError::TooFine) => (
+                format!("`{text}` is finer than a nanosecond"),
+                "not a whole number of nanoseconds".to_string(),
+                "durations are exact in integer nanoseconds; drop the extra decimals".to_string(),
+            ),
+            Err(LiteralError::TooLong) => (
+                format!("`{text}` is too long a duration"),
+                "beyond 2^64 nanoseconds".to_string(),
+                "a duration holds at most 18446744073s (about 584 years)".to_string(),
+            ),
+        };
+        self.error(span, message, label);
+        self.help_last(&help);
+        ExprKind::Duration(0)
+    }
+
+    fn help_last(&mut self, help: &str) {
+        if let Some(d) = self.diags.last_mut() {
+            d.help = Some(help.to_string());
+        }
+    }
 }

@@ -161,7 +161,7 @@ impl Builder {
 }
 
 /// Words of the language that cannot name anything (LANGUAGE.md §1).
-pub const RESERVED: [&str; 24] = [
+pub const RESERVED: [&str; 26] = [
     "enum",
     "buffer",
     "controller",
@@ -186,6 +186,8 @@ pub const RESERVED: [&str; 24] = [
     "cmd",
     "state_cycles",
     "plan_cycles",
+    "state_time",
+    "plan_time",
 ];
 
 fn bin_op(s: &str) -> BinOp {

@@ -6,9 +6,9 @@
 use super::expr::{rust_type, zero, Gen};
 use super::names::Names;
 use super::plan::{plan_fn, used_params, uses_subs};
+use super::shape::{shape, Shape, Wiring};
 use super::Comments;
 use crate::ident::prefixed;
-use proc_macro2::Ident;
 use proc_macro2::TokenStream;
 use quote::quote;
 use rcs_dsl::ir::*;
@@ -194,33 +194,7 @@ pub(crate) fn module(
     };
 
     // ---- statuses and errors
-    let status_consts = c.statuses.iter().enumerate().map(|(i, s)| {
-        let id = &n.status_consts[i];
-        let value = match i {
-            0 => quote!(rt::Status::NOT_READY),
-            1 => quote!(rt::Status::EXECUTING),
-            2 => quote!(rt::Status::DONE),
-            3 => quote!(rt::Status::ERROR),
-            _ => {
-                let k = (i - 4) as u16;
-                quote!(rt::Status::custom(#k))
-            }
-        };
-        let d = docs(&s.docs);
-        quote!(#d pub const #id: rt::Status = #value;)
-    });
-    let status_variants: Vec<_> = n.status_variants.iter().collect();
-    let status_consts_ids: Vec<_> = n.status_consts.iter().collect();
-    let status_names: Vec<&str> = c.statuses.iter().map(|s| s.name.as_str()).collect();
-    let error_consts = c.errors.iter().enumerate().map(|(i, e)| {
-        let id = &n.error_consts[i];
-        let k = i as u16;
-        let d = docs(&e.docs);
-        quote!(#d pub const #id: rt::ErrorCode = rt::ErrorCode::custom(#k);)
-    });
-    let error_variants: Vec<_> = n.error_variants.iter().collect();
-    let error_consts_ids: Vec<_> = n.error_consts.iter().collect();
-    let error_names: Vec<&str> = c.errors.iter().map(|e| e.name.as_str()).collect();
+    let codes = super::codes::codes(names, ci, c, name);
 
     // ---- plan state enums
     let state_enums = c.plans.iter().enumerate().map(|(pi, p)| {
@@ -533,9 +507,6 @@ pub(crate) fn module(
             .to_string(),
     );
     let step3 = comments.marker("3. A new serial starts the plan of its verb in S0.".to_string());
-    let status_doc =
-        format!(" `{name}`'s statuses as runtime values: the built-ins, then its own.");
-    let error_doc = format!(" `{name}`'s error codes as runtime values.");
     let step4 = comments.marker("4. Decide: the active plan fires at most one row.".to_string());
     let step5 =
         comments.marker("5. Write: status, written buffers, commands sent this cycle.".to_string());
@@ -551,24 +522,6 @@ pub(crate) fn module(
         self_name,
         data_init,
     } = shape(names, c, name, shared, vars_for_instance);
-    // The built-in error REFUSED, only where a verb can be refused.
-    let refuses = c.commands.iter().any(|k| k.accept.is_some());
-    let (refused_const, refused_variant, refused_from_raw, refused_raw, refused_name) = if refuses {
-        (
-            quote! {
-                /// A command refused by its verb's `accept when` (seen by the sender only).
-                pub const REFUSED: rt::ErrorCode = rt::ErrorCode::REFUSED;
-            },
-            quote!(Refused,),
-            quote!(if raw.0 == error::REFUSED.0 {
-                return Some(Self::Refused);
-            }),
-            quote!(Self::Refused => error::REFUSED,),
-            quote!(Self::Refused => "REFUSED",),
-        )
-    } else {
-        Default::default()
-    };
     quote! {
         #mod_docs
         pub mod #module {
@@ -580,80 +533,7 @@ pub(crate) fn module(
 
             #names_fns
 
-            #[doc = #status_doc]
-            pub mod status {
-                use ::rcs_runtime as rt;
-                #(#status_consts)*
-            }
-
-            #[doc = #error_doc]
-            pub mod error {
-                use ::rcs_runtime as rt;
-                /// No error.
-                pub const NONE: rt::ErrorCode = rt::ErrorCode::NONE;
-                /// A command whose verb has no plan (only from an outside writer).
-                pub const UNKNOWN_COMMAND: rt::ErrorCode = rt::ErrorCode::UNKNOWN_COMMAND;
-                /// An index by a run-time value outside its array (the cycle ended the plan).
-                pub const INDEX_RANGE: rt::ErrorCode = rt::ErrorCode::INDEX_RANGE;
-                /// A hook panicked; the executive caught it and ended the plan.
-                pub const HOOK_PANIC: rt::ErrorCode = rt::ErrorCode::HOOK_PANIC;
-                #refused_const
-                #(#error_consts)*
-            }
-
-            /// A status of this controller.
-            #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-            pub enum Status { #(#status_variants),* }
-            impl Status {
-                /// The typed status of a runtime value, if it is one of this controller's.
-                pub const fn from_raw(raw: rt::Status) -> Option<Self> {
-                    #(if raw.0 == status::#status_consts_ids.0 { return Some(Self::#status_variants); })*
-                    None
-                }
-                /// The runtime value.
-                pub const fn raw(self) -> rt::Status {
-                    match self { #(Self::#status_variants => status::#status_consts_ids),* }
-                }
-                /// The name as written in the plans.
-                pub const fn name(self) -> &'static str {
-                    match self { #(Self::#status_variants => #status_names),* }
-                }
-            }
-
-            /// An error code this controller reports.
-            #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-            pub enum Error { UnknownCommand, IndexRange, HookPanic, #refused_variant #(#error_variants),* }
-            impl Error {
-                /// The typed error of a runtime code (`None` for no error).
-                pub const fn from_raw(raw: rt::ErrorCode) -> Option<Self> {
-                    if raw.0 == error::UNKNOWN_COMMAND.0 { return Some(Self::UnknownCommand); }
-                    if raw.0 == error::INDEX_RANGE.0 { return Some(Self::IndexRange); }
-                    if raw.0 == error::HOOK_PANIC.0 { return Some(Self::HookPanic); }
-                    #refused_from_raw
-                    #(if raw.0 == error::#error_consts_ids.0 { return Some(Self::#error_variants); })*
-                    None
-                }
-                /// The runtime code.
-                pub const fn raw(self) -> rt::ErrorCode {
-                    match self {
-                        Self::UnknownCommand => error::UNKNOWN_COMMAND,
-                        Self::IndexRange => error::INDEX_RANGE,
-                        Self::HookPanic => error::HOOK_PANIC,
-                        #refused_raw
-                        #(Self::#error_variants => error::#error_consts_ids),*
-                    }
-                }
-                /// The name as written in the plans.
-                pub const fn name(self) -> &'static str {
-                    match self {
-                        Self::UnknownCommand => "UNKNOWN_COMMAND",
-                        Self::IndexRange => "INDEX_RANGE",
-                        Self::HookPanic => "HOOK_PANIC",
-                        #refused_name
-                        #(Self::#error_variants => #error_names),*
-                    }
-                }
-            }
+            #codes
 
             #(#state_enums)*
 
@@ -808,192 +688,5 @@ pub(crate) fn module(
 
             #extra
         }
-    }
-}
-
-/// What differs between a controller's own module and a type's shared one.
-struct Shape {
-    /// `NAME`, or the `Instance` and `Params` structs.
-    head: TokenStream,
-    /// The visibility of `hooks` and `data` (an instance's driver, in the
-    /// instance's module, reaches them).
-    vis: TokenStream,
-    inst_field: TokenStream,
-    inst_param: TokenStream,
-    inst_init: TokenStream,
-    /// The name in `new`, and in methods.
-    gm_name: TokenStream,
-    self_name: TokenStream,
-    data_init: TokenStream,
-}
-
-fn shape(
-    names: &Names,
-    c: &Controller,
-    name: &str,
-    shared: Option<&TypeModule>,
-    vars_for_instance: bool,
-) -> Shape {
-    let Some(t) = shared else {
-        return Shape {
-            head: quote! {
-                /// The controller's name in Global Memory and in traces.
-                pub const NAME: &str = #name;
-            },
-            vis: quote!(),
-            inst_field: quote!(),
-            inst_param: quote!(),
-            inst_init: quote!(),
-            gm_name: quote!(NAME),
-            self_name: quote!(NAME),
-            data_init: quote!(Data::default()),
-        };
-    };
-    let (r, w, s) = (
-        proc_macro2::Literal::usize_unsuffixed(c.reads.len()),
-        proc_macro2::Literal::usize_unsuffixed(c.writes.len()),
-        proc_macro2::Literal::usize_unsuffixed(c.subordinates.len()),
-    );
-    let fields: Vec<Ident> = (0..t.group.slots.len())
-        .map(super::names::SlotNames::field)
-        .collect();
-    let tys: Vec<TokenStream> = t
-        .group
-        .slots
-        .iter()
-        .map(|s| rust_type(names, &s.ty))
-        .collect();
-    let params_doc = format!(
-        " The values the instances of `{}` differ in: its parameters where its plans use them.",
-        t.ty
-    );
-    let inst_doc = format!(
-        " One instance of `{}`: its names in Global Memory and its parameters.",
-        t.ty
-    );
-    Shape {
-        head: quote! {
-            #[doc = #inst_doc]
-            #[derive(Clone, Copy, Debug, PartialEq)]
-            pub struct Instance {
-                /// The instance's name: its command and status buffers, traces.
-                pub name: &'static str,
-                /// The Global Memory buffers bound to its `reads`, in order.
-                pub reads: [&'static str; #r],
-                /// The Global Memory buffers bound to its `writes`, in order.
-                pub writes: [&'static str; #w],
-                /// The controllers bound to its `subordinates`, in order.
-                pub subs: [&'static str; #s],
-                /// Its parameters.
-                pub params: Params,
-            }
-            #[doc = #params_doc]
-            #[derive(Clone, Copy, Debug, PartialEq)]
-            pub struct Params { #(pub #fields: #tys),* }
-        },
-        vis: quote!(pub(super)),
-        inst_field: quote!(inst: Instance,),
-        inst_param: quote!(inst: Instance,),
-        inst_init: quote!(inst,),
-        gm_name: quote!(inst.name),
-        self_name: quote!(self.inst.name),
-        data_init: if vars_for_instance {
-            quote!(Data {
-                vars: Vars::for_instance(&inst),
-                ..Data::default()
-            })
-        } else {
-            quote!(Data::default())
-        },
-    }
-}
-
-/// A controller's Global Memory wiring, in declaration order: its `reads`
-/// and `writes` buffers (field in `Reads`/`Writes`, Rust type, name in
-/// Global Memory, handle field) and its subordinates (name, module, handle
-/// field). The controller and its scenario driver both build on it.
-pub(crate) struct Wiring<'a> {
-    pub read_fields: Vec<Ident>,
-    pub read_tys: Vec<TokenStream>,
-    /// Names in Global Memory: string literals, or in a type's shared
-    /// module the instance's (`inst.reads[0]`, see [`Wiring::of_instance`]).
-    pub read_names: Vec<TokenStream>,
-    pub read_handles: Vec<Ident>,
-    pub write_fields: Vec<Ident>,
-    pub write_tys: Vec<TokenStream>,
-    pub write_names: Vec<TokenStream>,
-    pub write_handles: Vec<Ident>,
-    pub sub_names: Vec<TokenStream>,
-    pub sub_modules: Vec<&'a Ident>,
-    pub sub_handles: Vec<Ident>,
-}
-
-impl<'a> Wiring<'a> {
-    pub fn new(ir: &'a Ir, names: &'a Names, ci: usize) -> Wiring<'a> {
-        let c = &ir.controllers[ci];
-        let n = &names.ctrls[ci];
-        let fields = |list: &[BufferId]| -> Vec<Ident> {
-            list.iter()
-                .map(|b| n.buffers[b.index()].clone().expect("own buffer"))
-                .collect()
-        };
-        let tys = |list: &[BufferId]| -> Vec<TokenStream> {
-            list.iter()
-                .map(|b| rust_type(names, &Type::Buffer(ir.buffers[b.index()].ty)))
-                .collect()
-        };
-        let gm_names = |list: &[BufferId]| -> Vec<TokenStream> {
-            list.iter()
-                .map(|b| {
-                    let n = ir.buffers[b.index()].name.as_str();
-                    quote!(#n)
-                })
-                .collect()
-        };
-        let handles = |prefix: &str, ids: &[Ident]| -> Vec<Ident> {
-            ids.iter().map(|f| prefixed(prefix, f)).collect()
-        };
-        let read_fields = fields(&c.reads);
-        let write_fields = fields(&c.writes);
-        Wiring {
-            read_handles: handles("in", &read_fields),
-            write_handles: handles("out", &write_fields),
-            sub_handles: handles("sub", &n.subs),
-            read_tys: tys(&c.reads),
-            write_tys: tys(&c.writes),
-            read_names: gm_names(&c.reads),
-            write_names: gm_names(&c.writes),
-            read_fields,
-            write_fields,
-            sub_names: c
-                .subordinates
-                .iter()
-                .map(|s| {
-                    let n = ir.controllers[s.index()].name.as_str();
-                    quote!(#n)
-                })
-                .collect(),
-            sub_modules: c
-                .subordinates
-                .iter()
-                .map(|s| &names.ctrls[s.index()].module)
-                .collect(),
-        }
-    }
-
-    /// The wiring of a type's shared module: every name in Global Memory
-    /// read from the instance, `#inst.reads[k]` and so on.
-    pub fn of_instance(mut self, inst: &TokenStream) -> Self {
-        let from = |list: &mut Vec<TokenStream>, field: &str| {
-            let field = quote::format_ident!("{}", field);
-            for (k, n) in list.iter_mut().enumerate() {
-                let k = proc_macro2::Literal::usize_unsuffixed(k);
-                *n = quote!(#inst.#field[#k]);
-            }
-        };
-        from(&mut self.read_names, "reads");
-        from(&mut self.write_names, "writes");
-        from(&mut self.sub_names, "subs");
-        self
     }
 }

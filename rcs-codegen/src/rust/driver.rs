@@ -8,9 +8,10 @@
 //! None of this is on a running system's cycle path: it allocates, and it
 //! is meant for tests.
 
-use super::controller::{derivable_default, Wiring};
+use super::controller::derivable_default;
 use super::expr::{rust_type, zero};
 use super::names::Names;
+use super::shape::Wiring;
 use crate::ident::prefixed;
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};

@@ -6,6 +6,7 @@
 
 mod accept;
 mod builtins;
+mod codes;
 mod controller;
 mod driver;
 mod every_cycle;
@@ -16,6 +17,7 @@ mod names;
 mod plan;
 mod process;
 mod schema;
+mod shape;
 mod system;
 mod types;
 mod verbs;

@@ -5,7 +5,7 @@
 use super::*;
 use proptest::sample::select;
 use rcs_dsl::interp;
-use rcs_dsl::ir::{Controller, ExprKind, Ir, Type};
+use rcs_dsl::ir::{Controller, ExprKind, Ir, SubProp, Type};
 use rcs_runtime::driver::Value;
 use rcs_runtime::{ErrorCode, Status};
 
@@ -404,7 +404,30 @@ impl<'a> Values<'a> {
                 } else {
                     Just(false).boxed()
                 };
-                let answer = (echo, status, 0..errors, fields, refused).prop_map(
+                // A supervisor that reads `X.error_code` also meets X's
+                // built-in codes (an unchanged strategy for the others, so
+                // their sequences stay the same).
+                let reads_code = c.plans.iter().flat_map(|p| &p.rows).any(|r| {
+                    let mut found = false;
+                    r.visit_exprs(&mut |e| {
+                        found |= matches!(e.kind, ExprKind::Sub(x, SubProp::ErrorCode) if x == *s)
+                    });
+                    found
+                });
+                let error = if reads_code {
+                    prop_oneof![
+                        3 => 0..errors,
+                        1 => select(vec![
+                            ErrorCode::UNKNOWN_COMMAND.0,
+                            ErrorCode::INDEX_RANGE.0,
+                            ErrorCode::HOOK_PANIC.0,
+                        ]),
+                    ]
+                    .boxed()
+                } else {
+                    (0..errors).boxed()
+                };
+                let answer = (echo, status, error, fields, refused).prop_map(
                     |(echo, status, error, fields, refused)| Answer {
                         echo,
                         status,

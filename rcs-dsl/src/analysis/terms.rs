@@ -453,6 +453,7 @@ pub fn same_leaf(a: &Leaf, b: &Leaf) -> bool {
         }
         (Leaf::SubStatus(x), Leaf::SubStatus(y)) | (Leaf::SubStale(x), Leaf::SubStale(y)) => x == y,
         (Leaf::BufStale(x), Leaf::BufStale(y)) => x == y,
+        (Leaf::SubErrorCode(x), Leaf::SubErrorCode(y)) => x == y,
         _ => false,
     }
 }

@@ -323,7 +323,18 @@ pub(crate) fn run_sequence(
                 p.ok(Call::WriteSubStatus(name, status))?;
             }
         }
-        p.cycles(i, step.cycles)?;
+        if seq.live_reads {
+            // A live writer: every buffer written again, as it stands,
+            // before each cycle of the step.
+            for _ in 0..step.cycles {
+                for (b, w) in c.reads.iter().zip(&world) {
+                    p.ok(Call::SetRead(&ir.buffers[b.index()].name, w.clone()))?;
+                }
+                p.cycles(i, 1)?;
+            }
+        } else {
+            p.cycles(i, step.cycles)?;
+        }
     }
     Ok(())
 }

@@ -249,7 +249,7 @@ fn a_swapped_row_is_caught() {
 
     let subject = Subject::new(set, &ir, &mutant, ctrl);
     let stats = Stats::default();
-    match run_plan(&subject, verb, 0, &stats) {
+    match run_plan(&subject, verb, 0, &stats).map_err(|e| *e) {
         Ok(()) => panic!(
             "{} sequences of {} cycles missed the swapped rows",
             stats.sequences.get(),

@@ -16,8 +16,9 @@ fn files(dir: &Path) -> BTreeSet<String> {
 }
 
 /// The generated Rust of `plans/`: one file per set, in path order.
-const ALL_RUST: [&str; 5] = [
+const ALL_RUST: [&str; 6] = [
     "bridgeport_io/rust/bridgeport_io.rs",
+    "fieldbus_drive/rust/fieldbus_drive.rs",
     "figure13/rust/figure13.rs",
     "packml/rust/packml.rs",
     "rcs_ex/rust/rcs_ex.rs",
@@ -50,6 +51,10 @@ fn building_plans_builds_each_set_into_its_own_folder_with_its_own_schedule() {
         "{err}"
     );
     assert!(err.contains("    Checking packml (2 files)\n"), "{err}");
+    assert!(
+        err.contains("    Checking fieldbus_drive (2 files)\n"),
+        "{err}"
+    );
     assert_eq!(rust_files(&out), ALL_RUST);
     // Each set keeps its own manifest: submarine's 30 ms CPU, figure13's default 10 ms.
     let sub = std::fs::read_to_string(out.join("submarine/rust/submarine.rs")).unwrap();
@@ -65,6 +70,7 @@ fn building_plans_builds_each_set_into_its_own_folder_with_its_own_schedule() {
         "plans/rcs_ex",
         "plans/bridgeport_io",
         "plans/packml",
+        "plans/fieldbus_drive",
         "-o",
         s(&named),
     ]);
@@ -92,6 +98,7 @@ fn the_repository_root_is_a_workspace_of_plans() {
     assert!(err.contains("scenarios of rcs_ex"), "{err}");
     assert!(err.contains("scenarios of bridgeport_io"), "{err}");
     assert!(err.contains("scenarios of packml"), "{err}");
+    assert!(err.contains("scenarios of fieldbus_drive"), "{err}");
     let _ = std::fs::remove_dir_all(&out);
 }
 
@@ -258,7 +265,14 @@ fn graph_ir_and_test_take_a_workspace() {
         .collect();
     assert_eq!(
         systems,
-        ["bridgeport_io", "figure13", "packml", "rcs_ex", "submarine"]
+        [
+            "bridgeport_io",
+            "fieldbus_drive",
+            "figure13",
+            "packml",
+            "rcs_ex",
+            "submarine"
+        ]
     );
     let o = rcsc(&["test", "plans"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
@@ -268,6 +282,7 @@ fn graph_ir_and_test_take_a_workspace() {
         "plans/rcs_ex",
         "plans/bridgeport_io",
         "plans/packml",
+        "plans/fieldbus_drive",
     ]
     .iter()
     .map(|set| {

@@ -26,6 +26,7 @@ fn every_plan_scenario_passes() {
         "../plans/rcs_ex",
         "../plans/bridgeport_io",
         "../plans/packml",
+        "../plans/fieldbus_drive",
     ] {
         let loaded = load_folder(Path::new(set)).expect("plans");
         let ir = check(&loaded, &Options::default()).ir.expect("clean");

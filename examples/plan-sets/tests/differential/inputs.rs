@@ -112,6 +112,11 @@ pub(crate) struct Sequence {
     pub(crate) vars: Option<Vec<Value>>,
     pub(crate) args: Vec<Value>,
     pub(crate) steps: Vec<Step>,
+    /// Every `reads` buffer is written again before every cycle, as a live
+    /// writer (a fieldbus master) does, so its watchdog stays at 0 through a
+    /// long step; otherwise a buffer is written only by the steps that
+    /// update it.
+    pub(crate) live_reads: bool,
 }
 
 /// Random values of the IR's types for one controller.
@@ -313,9 +318,13 @@ impl<'a> Values<'a> {
     /// about one step in three ends with every subordinate answering DONE: a plan
     /// valid only in some states of its vars, waiting each time for all
     /// its subordinates (a PackML unit's commands), is reached no other
-    /// way in thirty steps. Without it every sequence starts from the
-    /// declared initial values and no step is added, and no randomness is
-    /// drawn for either, so the sequences stay what they were.
+    /// way in thirty steps; and one sequence in two has a live writer for
+    /// its `reads` buffers (see [`Sequence::live_reads`]): a state timeout
+    /// longer than a frame watchdog on the buffer (a drive's 500 ms move
+    /// under a 10 ms watchdog) is reached no other way. Without it every
+    /// sequence starts from the declared initial values, no step is added
+    /// and no buffer is live, and no randomness is drawn for any of them,
+    /// so the sequences stay what they were.
     pub(crate) fn sequences(
         &self,
         c: &Controller,
@@ -329,6 +338,11 @@ impl<'a> Values<'a> {
             proptest::option::weighted(0.5, each).boxed()
         } else {
             Just(None).boxed()
+        };
+        let live_reads = if explore && !c.reads.is_empty() {
+            proptest::bool::weighted(0.5).boxed()
+        } else {
+            Just(false).boxed()
         };
         let all_done = if explore && !c.subordinates.is_empty() {
             proptest::bool::weighted(0.3).boxed()
@@ -456,12 +470,14 @@ impl<'a> Values<'a> {
             vars,
             self.args(c, verb),
             proptest::collection::vec(step, 1..=MAX_STEPS),
+            live_reads,
         )
-            .prop_map(|(reads, vars, args, steps)| Sequence {
+            .prop_map(|(reads, vars, args, steps, live_reads)| Sequence {
                 reads,
                 vars,
                 args,
                 steps,
+                live_reads,
             })
     }
 }

@@ -33,8 +33,12 @@
 //! 1,000 sequences gets up to seven more rounds of 1,000, which explore
 //! further: one sequence in two starts from random values of the
 //! controller's vars and status fields, as a scenario's `initial: vars`
-//! may, and about one step in three ends with every subordinate answering its
-//! latest command DONE), except the rows listed in [`NEVER_FIRE`], each of
+//! may, about one step in three ends with every subordinate answering its
+//! latest command DONE, one sequence in two writes its `reads` buffers
+//! before every cycle, as a live fieldbus master does, so that a state
+//! timeout longer than a frame watchdog can fire, and a subordinate's error
+//! code is now and then a built-in one, `INDEX_RANGE` or `HOOK_PANIC`),
+//! except the rows listed in [`NEVER_FIRE`], each of
 //! which provably cannot fire from the declared initial values (and must
 //! indeed never fire from them); and `a_swapped_row_is_caught` shows that a code
 //! generator that gets row precedence wrong is caught, as a divergence
@@ -245,7 +249,7 @@ fn a_swapped_row_is_caught() {
 
     let subject = Subject::new(set, &ir, &mutant, ctrl);
     let stats = Stats::default();
-    match run_plan(&subject, verb, 0, &stats) {
+    match run_plan(&subject, verb, 0, &stats).map_err(|e| *e) {
         Ok(()) => panic!(
             "{} sequences of {} cycles missed the swapped rows",
             stats.sequences.get(),

@@ -323,7 +323,18 @@ pub(crate) fn run_sequence(
                 p.ok(Call::WriteSubStatus(name, status))?;
             }
         }
-        p.cycles(i, step.cycles)?;
+        if seq.live_reads {
+            // A live writer: every buffer written again, as it stands,
+            // before each cycle of the step.
+            for _ in 0..step.cycles {
+                for (b, w) in c.reads.iter().zip(&world) {
+                    p.ok(Call::SetRead(&ir.buffers[b.index()].name, w.clone()))?;
+                }
+                p.cycles(i, 1)?;
+            }
+        } else {
+            p.cycles(i, step.cycles)?;
+        }
     }
     Ok(())
 }
@@ -347,13 +358,14 @@ pub(crate) fn seed(label: &str) -> [u8; 32] {
 }
 
 /// Run `SEQUENCES` sequences of the plan of `verb` on `subject`; `round`
-/// picks other (but always the same) sequences.
+/// picks other (but always the same) sequences. The error is boxed: it
+/// holds the minimal sequence, which is large.
 pub(crate) fn run_plan(
     subject: &Subject<'_>,
     verb: usize,
     round: u32,
     stats: &Stats,
-) -> Result<(), TestError<Sequence>> {
+) -> Result<(), Box<TestError<Sequence>>> {
     let c = subject.controller();
     let label = format!(
         "{}/{}/{}/{round}",
@@ -372,9 +384,11 @@ pub(crate) fn run_plan(
     // The first round starts every sequence from the declared initial
     // values; later rounds (for rows still missing) explore further.
     let strategy = values.sequences(c, &subject.leaves, verb, round > 0);
-    runner.run(&strategy, |seq| {
-        run_sequence(subject, verb, &seq, stats).map_err(TestCaseError::fail)
-    })
+    runner
+        .run(&strategy, |seq| {
+            run_sequence(subject, verb, &seq, stats).map_err(TestCaseError::fail)
+        })
+        .map_err(Box::new)
 }
 
 pub(crate) fn load(path: &str) -> Ir {

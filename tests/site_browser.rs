@@ -305,12 +305,7 @@ async fn the_site_in_chromium() {
         .send_keys("PR.AHEAD.S2")
         .await
         .unwrap();
-    c.find(Locator::Css("#results a"))
-        .await
-        .expect("a search result")
-        .click()
-        .await
-        .unwrap();
+    click_once_there(&c, "#results a").await;
     let url = c.current_url().await.unwrap();
     assert!(url.path().ends_with("/submarine/PR.AHEAD.html"), "{url}");
     assert_eq!(url.fragment(), Some("state-S2"));
@@ -337,6 +332,21 @@ async fn click(c: &Client, css: &str) {
     c.find(Locator::Css(css))
         .await
         .unwrap_or_else(|e| panic!("no `{css}`: {e}"))
+        .click()
+        .await
+        .unwrap();
+}
+
+/// The first element `css` finds once it is there, clicked: for what a
+/// script puts in the page later (the search's results, after its index
+/// loads). Readiness, not timing: a generous bound so that a page that
+/// never shows it cannot hang the suite.
+async fn click_once_there(c: &Client, css: &str) {
+    c.wait()
+        .at_most(Duration::from_secs(60))
+        .for_element(Locator::Css(css))
+        .await
+        .unwrap_or_else(|e| panic!("no `{css}` within 60 s: {e}"))
         .click()
         .await
         .unwrap();
@@ -405,7 +415,7 @@ async fn a_large_set_in_chromium() {
         .send_keys("C7.OP3")
         .await
         .unwrap();
-    click(&c, "#results a").await;
+    click_once_there(&c, "#results a").await;
     let url = c.current_url().await.unwrap();
     assert!(url.path().ends_with("/C7.OP3.html"), "{url}");
     let mut errors = console_errors(&c).await;

@@ -349,10 +349,7 @@ impl<'ir> Interpreter<'ir> {
 
 /// The error code a value of type `error` holds (a var, a status field).
 pub(crate) fn error_code(v: &Value) -> ErrorCode {
-    match v {
-        Value::Int(n) => ErrorCode(u16::try_from(*n).unwrap_or(0)),
-        _ => ErrorCode::NONE,
-    }
+    rcs_runtime::driver::FromValue::from_value(v).unwrap_or(ErrorCode::NONE)
 }
 
 /// Hooks for constant contexts (var initialisers call none).

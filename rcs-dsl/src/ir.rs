@@ -823,6 +823,12 @@ impl Controller {
         self.subordinates.iter().position(|s| *s == sub)
     }
 
+    /// Whether some verb has `accept when`: only then can this controller
+    /// answer a command with the built-in error `REFUSED`.
+    pub fn can_refuse(&self) -> bool {
+        self.commands.iter().any(|k| k.accept.is_some())
+    }
+
     /// A plan's name for people: its verbs as in its header, `GOTO | JOG`.
     pub fn plan_title(&self, p: &Plan) -> String {
         p.verbs

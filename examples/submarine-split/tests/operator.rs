@@ -53,14 +53,21 @@ fn until<R>(what: &str, mut f: impl FnMut() -> Option<R>) -> R {
     }
 }
 
+/// The operator's own process: its bridge, with the `operator`
+/// certificate, connected to the helm at `ep` and hearing it.
+fn operator(ep: &str, certs: &Path) -> (Operators, rcs_runtime::Bridge) {
+    let config = BridgeConfig::new("submarine_split", "operator")
+        .certs(certs)
+        .connect(ep);
+    let (ops, bridge) = Operators::remote(config).expect("the operator's bridge");
+    until("the helm as a peer", || (bridge.peers() > 0).then_some(()));
+    (ops, bridge)
+}
+
 #[test]
 fn operator_commands_a_root_in_another_process() {
     let (mut helm, _engine, ep, certs) = hierarchy();
-    let config = BridgeConfig::new("submarine_split", "operator")
-        .certs(&certs)
-        .connect(&ep);
-    let (mut ops, bridge) = Operators::remote(config).expect("the operator's bridge");
-    until("the helm as a peer", || (bridge.peers() > 0).then_some(()));
+    let (mut ops, bridge) = operator(&ep, &certs);
     let serial = ops.sm.command(sm::Command::Transit { speed: 8.0 });
     // SM takes the command (its status echoes it back to this process)...
     until("SM's echo of the operator's command", || {
@@ -78,11 +85,7 @@ fn operator_commands_a_root_in_another_process() {
 #[test]
 fn a_root_in_another_process_refuses_an_order_and_its_transit_goes_on() {
     let (mut helm, _engine, ep, certs) = hierarchy();
-    let config = BridgeConfig::new("submarine_split", "operator")
-        .certs(&certs)
-        .connect(&ep);
-    let (mut ops, bridge) = Operators::remote(config).expect("the operator's bridge");
-    until("the helm as a peer", || (bridge.peers() > 0).then_some(()));
+    let (mut ops, bridge) = operator(&ep, &certs);
     let slow = ops.sm.command(sm::Command::Transit { speed: 8.0 });
     until("SM's echo of the 8 kn order", || {
         (ops.sm.status().value.echo_serial == slow).then_some(())

@@ -43,7 +43,7 @@ pub(super) fn codes(names: &Names, ci: usize, c: &Controller, name: &str) -> Tok
         format!(" `{name}`'s statuses as runtime values: the built-ins, then its own.");
     let error_doc = format!(" `{name}`'s error codes as runtime values.");
     // The built-in error REFUSED, only where a verb can be refused.
-    let refuses = c.commands.iter().any(|k| k.accept.is_some());
+    let refuses = c.can_refuse();
     let (refused_const, refused_variant, refused_from_raw, refused_raw, refused_name) = if refuses {
         (
             quote! {

@@ -462,7 +462,7 @@ impl Resolver<'_> {
                 })
         };
         let refuses = || {
-            if sub.commands.iter().any(|k| k.accept.is_some()) {
+            if sub.can_refuse() {
                 Ok(())
             } else {
                 Err(err(

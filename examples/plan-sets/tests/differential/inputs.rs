@@ -413,7 +413,7 @@ impl<'a> Values<'a> {
                 let fields: Vec<_> = sub.status_fields().map(|(_, v)| self.of(&v.ty)).collect();
                 // A subordinate that can refuse (`accept when`) now
                 // and then refuses the command it answers.
-                let refused = if sub.commands.iter().any(|k| k.accept.is_some()) {
+                let refused = if sub.can_refuse() {
                     proptest::bool::weighted(0.2).boxed()
                 } else {
                     Just(false).boxed()

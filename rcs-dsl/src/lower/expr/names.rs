@@ -550,7 +550,7 @@ impl Cx<'_, '_> {
     /// one `cid` declares, or a built-in one it can have.
     fn error_name(&mut self, cid: CtrlId, name: &ast::Name, span: Span) -> (Expr, Ty) {
         let ctrl = &self.ir.controllers[cid.index()];
-        let refuses = ctrl.commands.iter().any(|k| k.accept.is_some());
+        let refuses = ctrl.can_refuse();
         let code = crate::error_codes::code_of(ctrl, &name.text)
             .filter(|c| *c != rcs_runtime::ErrorCode::REFUSED || refuses);
         if let Some(code) = code {

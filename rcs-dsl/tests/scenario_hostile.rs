@@ -90,8 +90,10 @@ proptest! {
             }
             text.replace_range(i..end, piece);
         }
-        let lines = text.lines().count().max(1);
-        match scenario::parse(&ir, &SourceFile::new("t.scenario.yaml", text.clone()), "t") {
+        // Lines as the reader counts them: a lone `\r` ends a line too.
+        let file = SourceFile::new("t.scenario.yaml", text.clone());
+        let lines = file.line_starts().len();
+        match scenario::parse(&ir, &file, "t") {
             Err(e) => prop_assert!(e.line >= 1 && e.line <= lines + 1, "line {} of {lines}: {}\n{text}", e.line, e.message),
             Ok(s) => {
                 // Keep the run short: a splice may ask for millions of cycles.
@@ -101,4 +103,24 @@ proptest! {
             }
         }
     }
+}
+
+/// The case CI found: a lone `\r` splits a line (YAML and our reader agree
+/// on that, `str::lines` does not) and an unterminated quote runs to the end.
+#[test]
+fn a_lone_carriage_return_and_an_open_quote_point_inside_the_file() {
+    let set = load_folder(Path::new("../plans/submarine")).expect("plans");
+    let ir = check(&set, &Options::default()).ir.expect("clean");
+    let text = "name: t\ncontroller: SM\nsteps:\n  - command: INIT\n    expect: { sent: {\r PR: INIT } }\n\"  - cycles: 1\n";
+    let file = SourceFile::new("t.scenario.yaml", text);
+    let Err(e) = scenario::parse(&ir, &file, "t") else {
+        panic!("an open quote was read")
+    };
+    assert!(
+        e.line >= 1 && e.line <= file.line_starts().len(),
+        "line {} of {}: {}",
+        e.line,
+        file.line_starts().len(),
+        e.message
+    );
 }

@@ -212,6 +212,12 @@ impl Code {
             Code::Lint(Lint::StatusNeverReported) => {
                 "a supervisor waits for a status the subordinate never reports"
             }
+            Code::Lint(Lint::StaleSubordinateStatus) => {
+                "a row can read a subordinate's answer to an earlier command"
+            }
+            Code::Lint(Lint::CommandOverwritten) => {
+                "a subordinate is commanded again before its answer to the last command is read"
+            }
             Code::Lint(Lint::IndexRange) => "an index by a run-time value can fall outside its array",
             Code::Lint(Lint::TimerResolution) => {
                 "a duration is not a whole number of the CPU's periods: the comparison fires later than written"

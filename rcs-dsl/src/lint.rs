@@ -23,12 +23,14 @@ pub enum Lint {
     Livelock,
     CommandEveryCycle,
     StatusNeverReported,
+    StaleSubordinateStatus,
+    CommandOverwritten,
     IndexRange,
     TimerResolution,
 }
 
 impl Lint {
-    pub const ALL: [Lint; 16] = [
+    pub const ALL: [Lint; 18] = [
         Lint::RuleOfTen,
         Lint::ShadowedRow,
         Lint::UnreachableState,
@@ -43,6 +45,8 @@ impl Lint {
         Lint::Livelock,
         Lint::CommandEveryCycle,
         Lint::StatusNeverReported,
+        Lint::StaleSubordinateStatus,
+        Lint::CommandOverwritten,
         Lint::IndexRange,
         Lint::TimerResolution,
     ];
@@ -63,6 +67,8 @@ impl Lint {
             Lint::Livelock => "livelock",
             Lint::CommandEveryCycle => "command_every_cycle",
             Lint::StatusNeverReported => "status_never_reported",
+            Lint::StaleSubordinateStatus => "stale_subordinate_status",
+            Lint::CommandOverwritten => "command_overwritten",
             Lint::IndexRange => "index_range",
             Lint::TimerResolution => "timer_resolution",
         }

@@ -423,6 +423,7 @@ fn stall_witnesses_hold_on_the_interpreter() {
         "../tests/data/err/2911_unhandled_error_reference_submarine",
         "../tests/data/err/2912_unhandled_error_status_test.rcs",
         "../tests/data/err/2913_unhandled_error_one_of_two_subordinates.rcs",
+        "../tests/data/err/5101_unhandled_error_watchdog_on_live_subordinate.rcs",
     ] {
         let sets = rcs_dsl::load_paths(&[case.into()]).unwrap();
         let ir = rcs_dsl::lower_unchecked(&sets[0]).expect(case);
@@ -433,8 +434,8 @@ fn stall_witnesses_hold_on_the_interpreter() {
                 let paths = a.paths();
                 for s in 0..p.states.len() {
                     let state = StateId(s as u32);
-                    for &x in &c.subordinates {
-                        let Some(stall) = a.stalls_in(state, x, StatusId::ERROR) else {
+                    for (&x, alive) in c.subordinates.iter().flat_map(|x| [(x, false), (x, true)]) {
+                        let Some(stall) = a.stalls_in(state, x, StatusId::ERROR, alive) else {
                             continue;
                         };
                         let Some(run) = a.stall_run(&paths, state, &stall, 30) else {
@@ -449,5 +450,5 @@ fn stall_witnesses_hold_on_the_interpreter() {
             }
         }
     }
-    assert!(stalls >= 4, "only {stalls} stalls replayed");
+    assert!(stalls >= 6, "only {stalls} stalls replayed");
 }

@@ -116,6 +116,8 @@ pub struct PlanAnalysis<'ir> {
     terms: Terms<'ir>,
     /// Per row: its condition (`None` for `otherwise`).
     conds: Vec<Option<Arc<Formula>>>,
+    /// The plan's verb's `accept when` condition, alone.
+    accept: Option<Formula>,
     /// Per leaf: a representative value of each of its cells.
     cells: Vec<Vec<Value>>,
     /// Per atom: for an exact one, its truth value on each cell of its leaf.
@@ -162,6 +164,10 @@ impl<'ir> PlanAnalysis<'ir> {
         // holds on the arrival cycle: every row the plan can fire then
         // needs it, so each condition C is read as `C && (!new_command || A)`,
         // which is exact (a refused command never shows `new_command`).
+        let accept_cond = ctrl.commands[plan.verb.index()]
+            .accept
+            .as_ref()
+            .map(|a| terms.formula(&a.cond));
         let accept = ctrl.commands[plan.verb.index()].accept.as_ref().map(|a| {
             let arrival = Expr {
                 kind: ExprKind::NewCommand,
@@ -199,6 +205,7 @@ impl<'ir> PlanAnalysis<'ir> {
             plan,
             terms,
             conds,
+            accept: accept_cond,
             cells,
             tables,
             candidates: std::cell::OnceCell::new(),
@@ -256,7 +263,17 @@ impl<'ir> PlanAnalysis<'ir> {
     /// `state` until a new command. `Some` carries one such cycle's inputs;
     /// `None` when some row may match (or the analysis cannot tell, or no
     /// condition reads `sub`'s status).
-    pub fn stalls_in(&self, state: StateId, sub: CtrlId, status: StatusId) -> Option<Witness> {
+    ///
+    /// With `alive`, `sub` keeps writing its status buffer every cycle of
+    /// this controller (it runs at least as often), so `sub.stale_cycles`
+    /// is 0 on every cycle: a watchdog on it cannot fire.
+    pub fn stalls_in(
+        &self,
+        state: StateId,
+        sub: CtrlId,
+        status: StatusId,
+        alive: bool,
+    ) -> Option<Witness> {
         if !self.analysed_over_cycles() {
             return None;
         }
@@ -264,6 +281,12 @@ impl<'ir> PlanAnalysis<'ir> {
         let any = self.conditions_covering(state)?;
         let mut fixed = self.fixed(state);
         fixed.push((leaf, Value::Status(status.0 as u16)));
+        if let Some(stale) = alive
+            .then(|| self.terms.find(&Leaf::SubStale(sub)))
+            .flatten()
+        {
+            fixed.push((stale, Value::Int(0)));
+        }
         let some_row = Formula::Or(any);
         if !matches!(self.prove(&some_row, &fixed), Outcome::None) {
             return None;
@@ -276,6 +299,20 @@ impl<'ir> PlanAnalysis<'ir> {
         {
             Outcome::Found(values) => Some(self.witness(&none, state, values)),
             Outcome::None | Outcome::Unknown => None,
+        }
+    }
+
+    /// Whether the verb's `accept when` condition can be false on a
+    /// command's arrival: `Some` carries such a cycle's inputs, in `S0`.
+    /// `None` when the verb has none, it always holds, or the analysis
+    /// cannot tell.
+    pub fn refusal(&self) -> Option<Witness> {
+        let accept = self.accept.as_ref()?;
+        let refused = Formula::Not(Box::new(accept.clone()));
+        let fixed = [(self.new_command, Value::Bool(true))];
+        match self.decide(&refused, &fixed, StateId::S0) {
+            Answer::Can(w) => Some(w),
+            Answer::Never | Answer::Unknown => None,
         }
     }
 

@@ -97,6 +97,36 @@ impl PlanAnalysis<'_> {
         paths
     }
 
+    /// `prefix`, then row `r` firing from `at` into `to` (`at` itself when
+    /// the row stays or ends the plan), after a wait for a counter if it
+    /// needs one; replayed. `None` when no such run is found.
+    pub fn fire_from(&self, prefix: &Run, r: usize, at: StateId, to: StateId) -> Option<Run> {
+        let scene = self.scene(prefix)?;
+        self.fire_after(prefix, &scene, r, at, to, &[])
+    }
+
+    /// `prefix`, then row `r` firing from `at` into `to` on the very next
+    /// cycle, with no wait; replayed. With the inputs of that cycle.
+    pub fn fire_at_once(
+        &self,
+        prefix: &Run,
+        r: usize,
+        at: StateId,
+        to: StateId,
+    ) -> Option<(Run, Witness)> {
+        let scene = self.scene(prefix)?;
+        let pins = self.pins(&scene, prefix, 0);
+        let Answer::Can(w) = self.can_fire_in_given(r, at, &pins) else {
+            return None;
+        };
+        let expect = Expect::Fires {
+            row: super::run::row_name(&self.plan.rows[r]),
+            state: self.plan.states.get(to.index())?.name.clone(),
+        };
+        let run = self.extend(prefix, &w, 1, expect)?;
+        Some((run, w))
+    }
+
     /// `prefix`, then row `r` firing from `at` into `to` (after a wait for a
     /// counter if it needs one).
     fn fire_after(

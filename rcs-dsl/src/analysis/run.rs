@@ -105,6 +105,18 @@ impl Expect {
         }
     }
 
+    /// The rows this expectation fires, without repeats.
+    pub fn fired_rows(&self) -> Vec<&str> {
+        let mut rows: Vec<&str> = match self {
+            Expect::Fires { row, .. } => vec![row],
+            Expect::IndexRange { row } => row.iter().map(String::as_str).collect(),
+            Expect::Stays { .. } => Vec::new(),
+            Expect::Repeats { rows } => rows.iter().map(|f| f.row.as_str()).collect(),
+        };
+        rows.dedup();
+        rows
+    }
+
     /// The row fired on the last cycle and the state after it (`None`:
     /// the plan ended with `INDEX_RANGE`, in no state a scenario names).
     fn last(&self, cycles: u32) -> (Option<&str>, Option<&str>) {

@@ -15,10 +15,11 @@ pub(crate) fn check_index_range(
     c: &Controller,
     p: &Plan,
     an: &PlanAnalysis,
+    out_of_range: &[crate::analysis::index_range::OutOfRange],
     sink: &mut Sink,
 ) {
     let printer = crate::pretty::Printer::new(ir, c, Some(p));
-    for found in an.out_of_range() {
+    for found in out_of_range {
         let site = &an.index_sites()[found.site];
         let index = printer.expr(&site.index);
         let len = site.len;
@@ -80,7 +81,7 @@ pub(crate) fn check_index_range(
             format!("`{index}` can be outside 0..{len} here"),
         )
         .with_witness(state, &found.witness.shown)
-        .with_run(Some(found.run))
+        .with_run(Some(found.run.clone()))
         .with_note(format!("with these inputs {then}"))
         .with_help(format!(
             "{fix}; or accept INDEX_RANGE as the error with `#[allow(index_range)]`"

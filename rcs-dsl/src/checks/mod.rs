@@ -137,7 +137,16 @@ pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagno
             diags: &mut diags,
         };
         if let Some((conditions, graphs)) = taken {
-            handshake::check_unhandled_error(ir, *ci, &conditions, &graphs, &summaries, &mut sink);
+            let sup = handshake::Supervisor {
+                ir,
+                id: *ci,
+                conditions: &conditions,
+                graphs: &graphs,
+                summaries: &summaries,
+            };
+            handshake::check_unhandled_error(&sup, &mut sink);
+            handshake::check_stale_subordinate_status(&sup, &mut sink);
+            handshake::check_command_overwritten(&sup, &mut sink);
         }
         handshake::check_status_never_reported(ir, *ci, &summaries, &mut sink);
         diags
@@ -189,13 +198,28 @@ fn analyse_controller<'ir>(ir: &'ir Ir, ci: CtrlId, levels: &LintLevels) -> Anal
         levels,
         diags: &mut diags,
     };
-    for ((p, conditions), analysis) in c.plans.iter().zip(&conditions).zip(&graphs) {
-        check_plan(ir, c, p, conditions, analysis, &mut sink);
+    // Where an index can fall outside its array: the `index_range` lint's
+    // findings, and for a supervisor a way this controller can fail.
+    let out_of_range: Vec<Vec<crate::analysis::index_range::OutOfRange>> =
+        conditions.iter().map(|a| a.out_of_range()).collect();
+    for (((p, conditions), analysis), out) in c
+        .plans
+        .iter()
+        .zip(&conditions)
+        .zip(&graphs)
+        .zip(&out_of_range)
+    {
+        check_plan(ir, c, p, conditions, analysis, out, &mut sink);
     }
     usage::check_float_equality(c, &mut sink);
     time::check_timer_resolution(ir, ci, &mut sink);
     let uses = usage::check_unused_in_controller(ir, ci, &mut sink);
-    let summary = handshake::Summary::of(c, &conditions, &graphs);
+    let sites: Vec<Vec<crate::source::Span>> = out_of_range
+        .iter()
+        .zip(&conditions)
+        .map(|(out, a)| out.iter().map(|o| a.index_sites()[o.site].span).collect())
+        .collect();
+    let summary = handshake::Summary::of(c, &conditions, &graphs, &sites);
     // Only the handshake checks read the analyses again, and only those of
     // a controller with subordinates: the others' analyses (most
     // controllers of a hierarchy are leaves) are freed here, on the thread
@@ -218,6 +242,7 @@ fn check_plan(
     p: &Plan,
     conditions: &PlanAnalysis,
     analysis: &graph::Analysis,
+    out_of_range: &[crate::analysis::index_range::OutOfRange],
     sink: &mut Sink,
 ) {
     plan::check_row_numbers(c, p, sink);
@@ -239,5 +264,5 @@ fn check_plan(
     hang::check_incomplete_states(c, p, conditions, analysis, sink);
     loops::check_livelocks(c, p, conditions, sink);
     loops::check_command_storms(ir, c, p, conditions, sink);
-    index::check_index_range(ir, c, p, conditions, sink);
+    index::check_index_range(ir, c, p, conditions, out_of_range, sink);
 }

@@ -1,0 +1,423 @@
+//! Checks across a supervisor and its subordinates, through the handshake
+//! (stage 3b: after every controller's own analysis). A subordinate is
+//! modelled by what its plans can answer to the verbs its supervisor sends
+//! it — a [`Summary`] taken from its analyses — so each finding about a
+//! supervisor is proved against what the subordinate can really do:
+//!
+//! - [`unhandled`]: `unhandled_error`, a state waits for X's answer where
+//!   nothing can fire once X fails (`Error`, `report ERROR`, a built-in
+//!   `INDEX_RANGE`, a refusal), a watchdog on a live X included;
+//! - [`reported`]: `status_never_reported`, a wait for a status X never
+//!   shows (a report overwritten in its own row does not count);
+//! - [`stale`]: `stale_subordinate_status`, a row reads X's answer before
+//!   this plan commanded X, so it sees an earlier command's answer;
+//! - [`overwritten`]: `command_overwritten`, a second command to X from
+//!   another row on the next cycle, before anything read X's answer.
+
+mod overwritten;
+mod reported;
+mod stale;
+mod unhandled;
+
+pub(crate) use overwritten::check_command_overwritten;
+pub(crate) use reported::check_status_never_reported;
+pub(crate) use stale::check_stale_subordinate_status;
+pub(crate) use unhandled::check_unhandled_error;
+
+use super::graph::Analysis;
+use crate::analysis::{covers, PlanAnalysis};
+use crate::ast::BinOp;
+use crate::ir::{
+    CommandId, Controller, CtrlId, Expr, ExprKind, Ir, Job, Plan, Row, StateId, StatusId, SubProp,
+    Target,
+};
+use crate::source::Span;
+
+/// What a supervisor's handshake checks read: its plans with their
+/// analyses, and every controller's [`Summary`].
+pub(crate) struct Supervisor<'a, 'ir> {
+    pub(crate) ir: &'ir Ir,
+    pub(crate) id: CtrlId,
+    pub(crate) conditions: &'a [PlanAnalysis<'ir>],
+    pub(crate) graphs: &'a [Analysis],
+    pub(crate) summaries: &'a [Summary],
+}
+
+impl<'a, 'ir> Supervisor<'a, 'ir> {
+    pub(crate) fn controller(&self) -> &'ir Controller {
+        self.ir.controller(self.id)
+    }
+
+    /// The plans the analysis answers questions about, with their
+    /// analyses; with `over_cycles`, only those it follows over cycles
+    /// (see [`PlanAnalysis::analysed_over_cycles`]).
+    pub(crate) fn plans(
+        &self,
+        over_cycles: bool,
+    ) -> impl Iterator<Item = (&'ir Plan, &'a PlanAnalysis<'ir>, &'a Analysis)> + use<'a, 'ir> {
+        let c = self.controller();
+        c.plans
+            .iter()
+            .zip(self.conditions)
+            .zip(self.graphs)
+            .map(|((p, an), g)| (p, an, g))
+            .filter(move |(_, an, _)| {
+                if over_cycles {
+                    an.analysed_over_cycles()
+                } else {
+                    an.analysed()
+                }
+            })
+    }
+}
+
+/// One way a subordinate's plan can answer `ERROR`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Failure {
+    /// A row that can fire ends in `Error`.
+    Ends { row: usize },
+    /// A row that can fire has `report ERROR` and goes on.
+    Reports { row: usize },
+    /// An index by a value can fall outside its array: the built-in
+    /// `INDEX_RANGE` (found with a replayed run by the `index_range` check).
+    IndexRange { span: Span },
+}
+
+/// What a supervisor's handshake checks need of a subordinate's plans,
+/// taken from the subordinate's analyses as soon as they are made: the
+/// checks of each controller then run on the worker threads with its own
+/// analyses and its subordinates' summaries, and no controller's analyses
+/// have to outlive its own checks.
+pub(crate) struct Summary {
+    /// Per plan: the first way it can answer `ERROR`.
+    failures: Vec<Option<Failure>>,
+    /// Per command: the `accept when` span, where the condition can be
+    /// false on a command's arrival (the command is then `REFUSED`).
+    refusals: Vec<Option<Span>>,
+    /// Per plan: the statuses a supervisor can see it report (`DONE` and
+    /// `ERROR` for rows ending there), in row order.
+    reported: Vec<Vec<StatusId>>,
+    /// Per plan: reports no supervisor can see, because a later write in
+    /// the same row (another `report`, `-> Done`, `-> Error`) replaces
+    /// the status before it is written: (status, report, replaced by).
+    overwritten: Vec<Vec<(StatusId, Span, Span)>>,
+    /// Per plan: whether it can answer (end, report, refuse or stop with a
+    /// built-in error) on its first cycle.
+    answers_at_once: Vec<bool>,
+}
+
+impl Summary {
+    pub(crate) fn of(
+        c: &Controller,
+        conditions: &[PlanAnalysis],
+        graphs: &[Analysis],
+        out_of_range: &[Vec<Span>],
+    ) -> Summary {
+        let plans = || c.plans.iter().zip(conditions).zip(graphs);
+        let failures = plans()
+            .zip(out_of_range)
+            .map(|(((plan, _), graph), out)| {
+                let can_fire = |r: &Row| {
+                    !graph.never_matches[r.position as usize]
+                        && super::plan::from_reachable(r, graph)
+                };
+                let ends = plan.rows.iter().position(|r| {
+                    matches!(r.to, Target::Error(_) | Target::ErrorOf(_)) && can_fire(r)
+                });
+                let reports = plan.rows.iter().position(|r| {
+                    can_fire(r)
+                        && visible_reports(r)
+                            .iter()
+                            .any(|(s, _)| *s == StatusId::ERROR)
+                });
+                ends.map(|row| Failure::Ends { row })
+                    .or(reports.map(|row| Failure::Reports { row }))
+                    .or(out.first().map(|&span| Failure::IndexRange { span }))
+            })
+            .collect();
+        let refusals = c
+            .commands
+            .iter()
+            .enumerate()
+            .map(|(ki, k)| {
+                let accept = k.accept.as_ref()?;
+                let pid = k.plan?.index();
+                // The analysis of a plan reads its own verb's condition.
+                let an = conditions.get(pid)?;
+                if c.plans[pid].verb.index() != ki {
+                    return None;
+                }
+                an.refusal().map(|_| accept.span)
+            })
+            .collect();
+        let reported = plans()
+            .map(|((plan, conditions), graph)| reported_by(plan, conditions, graph))
+            .collect();
+        let overwritten = c
+            .plans
+            .iter()
+            .map(|p| p.rows.iter().flat_map(overwritten_reports).collect())
+            .collect();
+        let answers_at_once = plans()
+            .zip(out_of_range)
+            .map(|(((plan, conditions), graph), out)| {
+                let refusable = c.commands[plan.verb.index()].accept.is_some();
+                refusable
+                    || !out.is_empty()
+                    || plan.rows.iter().enumerate().any(|(i, r)| {
+                        let answers = !matches!(r.to, Target::State(_) | Target::Same)
+                            || !visible_reports(r).is_empty();
+                        answers
+                            && covers(&r.from, StateId::S0)
+                            && !graph.never_matches[i]
+                            && !conditions.never_fires_in(i, StateId::S0)
+                    })
+            })
+            .collect();
+        Summary {
+            failures,
+            refusals,
+            reported,
+            overwritten,
+            answers_at_once,
+        }
+    }
+}
+
+/// How subordinate `x` can answer `ERROR` to `verb`: a way of its plan,
+/// or a refusal; `None` when the analysis shows none (or `verb` has no
+/// plan).
+pub(crate) fn failure(ir: &Ir, summaries: &[Summary], x: CtrlId, verb: CommandId) -> Option<Why> {
+    let pid = ir.controller(x).commands[verb.index()].plan?.index();
+    let s = &summaries[x.index()];
+    s.failures[pid]
+        .map(|f| Why::Plan {
+            plan: pid,
+            failure: f,
+        })
+        .or(s.refusals[verb.index()].map(|span| Why::Refused { verb, span }))
+}
+
+/// A subordinate's way to answer `ERROR`, located for a label.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Why {
+    Plan { plan: usize, failure: Failure },
+    Refused { verb: CommandId, span: Span },
+}
+
+impl Why {
+    /// The place to point at, and what to say there.
+    pub(crate) fn label(self, ir: &Ir, x: CtrlId) -> (Span, String) {
+        let xc = ir.controller(x);
+        let sub = &xc.name;
+        match self {
+            Why::Plan { plan, failure } => {
+                let p = &xc.plans[plan];
+                let verb = xc.plan_title(p);
+                match failure {
+                    Failure::Ends { row } => (
+                        p.rows[row].span,
+                        format!("`{sub}`'s plan `{verb}` can end in `Error` here"),
+                    ),
+                    Failure::Reports { row } => (
+                        p.rows[row].span,
+                        format!("`{sub}`'s plan `{verb}` can report `ERROR` here and go on"),
+                    ),
+                    Failure::IndexRange { span } => (
+                        span,
+                        format!(
+                            "`{sub}`'s plan `{verb}` can stop here with the built-in error \
+                             `INDEX_RANGE`"
+                        ),
+                    ),
+                }
+            }
+            Why::Refused { verb, span } => (
+                span,
+                format!(
+                    "`{sub}` can refuse `{}` here: the supervisor sees `ERROR(REFUSED)`",
+                    xc.commands[verb.index()].name
+                ),
+            ),
+        }
+    }
+}
+
+/// Whether `x`, alive, writes its status on every cycle of `sup`: it runs
+/// at least as often, so `x.stale_cycles` reads 0 on each of them.
+pub(crate) fn writes_every_cycle_of(ir: &Ir, sup: CtrlId, x: CtrlId) -> bool {
+    let period = |c: CtrlId| {
+        ir.schedule
+            .iter()
+            .find(|cpu| cpu.order.contains(&c))
+            .map(|cpu| cpu.period_ns)
+    };
+    match (period(sup), period(x)) {
+        (Some(s), Some(xp)) => xp <= s,
+        _ => false,
+    }
+}
+
+/// The verbs `rows` send to subordinate `x`, in order, without repeats.
+pub(crate) fn verbs_sent(rows: &[Row], x: CtrlId) -> Vec<CommandId> {
+    let mut verbs = Vec::new();
+    for r in rows {
+        for j in &r.jobs {
+            if j.sends_to().is_some_and(|(sub, _)| sub == x) {
+                for command in j.commands_sent() {
+                    if !verbs.contains(&command) {
+                        verbs.push(command);
+                    }
+                }
+            }
+        }
+    }
+    verbs
+}
+
+/// The verbs any plan of `c` sends `x`, without repeats.
+pub(crate) fn verbs_sent_by(c: &Controller, x: CtrlId) -> Vec<CommandId> {
+    c.plans
+        .iter()
+        .flat_map(|p| verbs_sent(&p.rows, x))
+        .fold(Vec::new(), |mut vs, v| {
+            if !vs.contains(&v) {
+                vs.push(v);
+            }
+            vs
+        })
+}
+
+/// Whether a row sends `x` a command.
+pub(crate) fn sends(r: &Row, x: CtrlId) -> bool {
+    r.jobs
+        .iter()
+        .any(|j| j.sends_to().is_some_and(|(sub, _)| sub == x))
+}
+
+/// The reports of a row a supervisor can see: the last one, unless the
+/// row ends the plan (the final status replaces it in the same cycle).
+fn visible_reports(r: &Row) -> Vec<(StatusId, Span)> {
+    if !matches!(r.to, Target::State(_) | Target::Same) {
+        return Vec::new();
+    }
+    r.jobs
+        .iter()
+        .filter_map(|j| match j {
+            Job::Report { status, span, .. } => Some((*status, *span)),
+            _ => None,
+        })
+        .next_back()
+        .into_iter()
+        .collect()
+}
+
+/// The reports of a row that a later write of the same cycle replaces.
+fn overwritten_reports(r: &Row) -> Vec<(StatusId, Span, Span)> {
+    let reports: Vec<(StatusId, Span)> = r
+        .jobs
+        .iter()
+        .filter_map(|j| match j {
+            Job::Report { status, span, .. } => Some((*status, *span)),
+            _ => None,
+        })
+        .collect();
+    let ends = !matches!(r.to, Target::State(_) | Target::Same);
+    reports
+        .iter()
+        .enumerate()
+        .filter_map(|(i, &(status, span))| {
+            let by = if ends {
+                Some(r.to_span)
+            } else {
+                reports
+                    .get(i + 1..)
+                    .and_then(|later| later.last())
+                    .map(|l| l.1)
+            };
+            by.map(|by| (status, span, by))
+        })
+        .collect()
+}
+
+/// The statuses the rows of `plan` that can fire make visible, in row
+/// order, without repeats.
+fn reported_by(plan: &Plan, conditions: &PlanAnalysis, graph: &Analysis) -> Vec<StatusId> {
+    let mut reported = Vec::new();
+    let mut add = |s: StatusId| {
+        if !reported.contains(&s) {
+            reported.push(s);
+        }
+    };
+    for (i, r) in plan.rows.iter().enumerate() {
+        let can_fire = !graph.never_matches[i]
+            && (0..plan.states.len())
+                .any(|s| graph.reachable[s] && !conditions.never_fires_in(i, StateId(s as u32)));
+        if !can_fire {
+            continue;
+        }
+        match r.to {
+            Target::Done => add(StatusId::DONE),
+            Target::Error(_) | Target::ErrorOf(_) => add(StatusId::ERROR),
+            Target::State(_) | Target::Same => {}
+        }
+        for (s, _) in visible_reports(r) {
+            add(s);
+        }
+    }
+    reported
+}
+
+/// The statuses of `x` a row's condition waits for, with the test's span:
+/// `x.done`, `x.error`, `x.status == S` (either way round), where the
+/// condition holds only if the test does (not under a `!`).
+pub(crate) fn status_tests(r: &Row, x: CtrlId) -> Vec<(StatusId, Span)> {
+    let mut found = Vec::new();
+    if let crate::ir::Condition::When(e) = &r.cond {
+        waits_in(e, x, &mut found);
+    }
+    found
+}
+
+fn waits_in(e: &Expr, x: CtrlId, found: &mut Vec<(StatusId, Span)>) {
+    let status_of_x = |e: &Expr| matches!(e.kind, ExprKind::Sub(c, SubProp::Status) if c == x);
+    let constant = |e: &Expr| match e.kind {
+        ExprKind::Status(s) => Some(s),
+        _ => None,
+    };
+    match &e.kind {
+        ExprKind::Sub(c, SubProp::Done) if *c == x => found.push((StatusId::DONE, e.span)),
+        ExprKind::Sub(c, SubProp::Error) if *c == x => found.push((StatusId::ERROR, e.span)),
+        ExprKind::Binary(BinOp::And | BinOp::Or, operands) => {
+            let [l, r] = &**operands;
+            waits_in(l, x, found);
+            waits_in(r, x, found);
+        }
+        ExprKind::Binary(BinOp::Eq, operands) => {
+            let [l, r] = &**operands;
+            let tested = if status_of_x(l) {
+                constant(r)
+            } else if status_of_x(r) {
+                constant(l)
+            } else {
+                None
+            };
+            if let Some(s) = tested {
+                found.push((s, e.span));
+            }
+        }
+        _ => {}
+    }
+}
+
+/// Whether a row's condition reads anything of `x`'s answer (status,
+/// `done`, `error`, `executing`, error code, watchdog or status fields).
+pub(crate) fn reads_answer_of(r: &Row, x: CtrlId) -> bool {
+    let mut found = false;
+    if let crate::ir::Condition::When(e) = &r.cond {
+        e.visit(&mut |e| {
+            found |= matches!(e.kind, ExprKind::Sub(c, _) | ExprKind::SubField(c, _) if c == x)
+        });
+    }
+    found
+}

@@ -218,6 +218,9 @@ impl Code {
             Code::Lint(Lint::CommandOverwritten) => {
                 "a subordinate is commanded again before its answer to the last command is read"
             }
+            Code::Lint(Lint::AlwaysRejected) => {
+                "a command is sent that the subordinate always answers with ERROR at once"
+            }
             Code::Lint(Lint::IndexRange) => "an index by a run-time value can fall outside its array",
             Code::Lint(Lint::TimerResolution) => {
                 "a duration is not a whole number of the CPU's periods: the comparison fires later than written"

@@ -25,12 +25,13 @@ pub enum Lint {
     StatusNeverReported,
     StaleSubordinateStatus,
     CommandOverwritten,
+    AlwaysRejected,
     IndexRange,
     TimerResolution,
 }
 
 impl Lint {
-    pub const ALL: [Lint; 18] = [
+    pub const ALL: [Lint; 19] = [
         Lint::RuleOfTen,
         Lint::ShadowedRow,
         Lint::UnreachableState,
@@ -47,6 +48,7 @@ impl Lint {
         Lint::StatusNeverReported,
         Lint::StaleSubordinateStatus,
         Lint::CommandOverwritten,
+        Lint::AlwaysRejected,
         Lint::IndexRange,
         Lint::TimerResolution,
     ];
@@ -69,6 +71,7 @@ impl Lint {
             Lint::StatusNeverReported => "status_never_reported",
             Lint::StaleSubordinateStatus => "stale_subordinate_status",
             Lint::CommandOverwritten => "command_overwritten",
+            Lint::AlwaysRejected => "always_rejected",
             Lint::IndexRange => "index_range",
             Lint::TimerResolution => "timer_resolution",
         }

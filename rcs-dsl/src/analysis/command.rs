@@ -184,6 +184,11 @@ impl PlanAnalysis<'_> {
         // Per state: no row covering it can match whatever the command.
         let mut dead: Vec<Option<bool>> = vec![None; n];
         for case in cases {
+            // A command with these values is refused on arrival whatever
+            // else holds (`accept when`): the plan never runs with them.
+            if self.always_refused(&case) {
+                continue;
+            }
             let mut given = case.clone();
             given.extend(constants.iter().cloned());
             let walk = self.walk(&given, true);

@@ -57,7 +57,7 @@ pub mod terms;
 mod walk;
 
 use crate::ir::{
-    Condition, Controller, CtrlId, Expr, ExprKind, From, Ir, Plan, StateId, StatusId, Type,
+    Condition, Controller, CtrlId, Expr, ExprKind, From, Ir, Plan, StateId, StatusId, Target, Type,
 };
 use rcs_runtime::driver::Value;
 use search::{Mode, Outcome, Search};
@@ -314,6 +314,56 @@ impl<'ir> PlanAnalysis<'ir> {
             Answer::Can(w) => Some(w),
             Answer::Never | Answer::Unknown => None,
         }
+    }
+
+    /// Whether the verb's `accept when` is false on a command's arrival
+    /// whatever the inputs not `given` (the command's parameters) are: a
+    /// proof that such a command is refused; `false` when unknown.
+    pub fn always_refused(&self, given: &[(LeafId, Value)]) -> bool {
+        let Some(accept) = &self.accept else {
+            return false;
+        };
+        let mut fixed = vec![(self.new_command, Value::Bool(true))];
+        fixed.extend(given.iter().cloned());
+        matches!(self.prove(accept, &fixed), Outcome::None)
+    }
+
+    /// Whether a command of this plan's verb is answered `ERROR` on its
+    /// arrival cycle whatever the inputs, with the `given` leaves (its
+    /// parameters) pinned: refused by `accept when`, or accepted and then
+    /// the first row to match always ends in `Error`. A proof: `None` when
+    /// it is not so or the analysis cannot tell. `Some(rows)` lists the
+    /// rows that can answer (empty for a refusal).
+    pub fn always_rejects(&self, given: &[(LeafId, Value)]) -> Option<Vec<usize>> {
+        if self.skipped || self.indexed {
+            return None;
+        }
+        if self.always_refused(given) {
+            return Some(Vec::new());
+        }
+        let mut fixed = vec![(self.new_command, Value::Bool(true))];
+        fixed.extend(given.iter().cloned());
+        let accepted = self.accept.clone().unwrap_or(Formula::Const(true));
+        let mut failing = Vec::new();
+        for (i, row) in self.plan.rows.iter().enumerate() {
+            let Some(fires) = self.fires(i, StateId::S0) else {
+                continue;
+            };
+            let can = !matches!(self.prove(&fires, &fixed), Outcome::None);
+            match row.to {
+                Target::Error(_) | Target::ErrorOf(_) if can => failing.push(i),
+                Target::Error(_) | Target::ErrorOf(_) => {}
+                _ if can => return None,
+                _ => {}
+            }
+        }
+        // Accepted, some row must fire: else the plan waits in S0.
+        let any = self.conditions_covering(StateId::S0)?;
+        let idle = Formula::And(vec![accepted, Formula::Not(Box::new(Formula::Or(any)))]);
+        if !matches!(self.prove(&idle, &fixed), Outcome::None) || failing.is_empty() {
+            return None;
+        }
+        Some(failing)
     }
 
     /// [`can_match`](Self::can_match) is [`Answer::Never`], without looking

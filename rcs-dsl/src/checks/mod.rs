@@ -147,6 +147,7 @@ pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagno
             handshake::check_unhandled_error(&sup, &mut sink);
             handshake::check_stale_subordinate_status(&sup, &mut sink);
             handshake::check_command_overwritten(&sup, &mut sink);
+            handshake::check_always_rejected(&sup, &mut sink);
         }
         handshake::check_status_never_reported(ir, *ci, &summaries, &mut sink);
         diags
@@ -219,7 +220,7 @@ fn analyse_controller<'ir>(ir: &'ir Ir, ci: CtrlId, levels: &LintLevels) -> Anal
         .zip(&conditions)
         .map(|(out, a)| out.iter().map(|o| a.index_sites()[o.site].span).collect())
         .collect();
-    let summary = handshake::Summary::of(c, &conditions, &graphs, &sites);
+    let summary = handshake::Summary::of(ir, c, &conditions, &graphs, &sites);
     // Only the handshake checks read the analyses again, and only those of
     // a controller with subordinates: the others' analyses (most
     // controllers of a hierarchy are leaves) are freed here, on the thread

@@ -12,14 +12,18 @@
 //! - [`stale`]: `stale_subordinate_status`, a row reads X's answer before
 //!   this plan commanded X, so it sees an earlier command's answer;
 //! - [`overwritten`]: `command_overwritten`, a second command to X from
-//!   another row on the next cycle, before anything read X's answer.
+//!   another row on the next cycle, before anything read X's answer;
+//! - [`rejected`]: `always_rejected`, a command with constant arguments
+//!   that X always answers `ERROR` at once.
 
 mod overwritten;
+mod rejected;
 mod reported;
 mod stale;
 mod unhandled;
 
 pub(crate) use overwritten::check_command_overwritten;
+pub(crate) use rejected::check_always_rejected;
 pub(crate) use reported::check_status_never_reported;
 pub(crate) use stale::check_stale_subordinate_status;
 pub(crate) use unhandled::check_unhandled_error;
@@ -104,10 +108,14 @@ pub(crate) struct Summary {
     /// Per plan: whether it can answer (end, report, refuse or stop with a
     /// built-in error) on its first cycle.
     answers_at_once: Vec<bool>,
+    /// The commands with constant arguments its supervisor sends it that
+    /// it always answers `ERROR` at once.
+    rejected: Vec<rejected::Rejected>,
 }
 
 impl Summary {
     pub(crate) fn of(
+        ir: &Ir,
         c: &Controller,
         conditions: &[PlanAnalysis],
         graphs: &[Analysis],
@@ -180,6 +188,7 @@ impl Summary {
             reported,
             overwritten,
             answers_at_once,
+            rejected: rejected::rejections(ir, c, conditions),
         }
     }
 }

@@ -316,6 +316,25 @@ impl<'ir> PlanAnalysis<'ir> {
         }
     }
 
+    /// [`never_fires_in`](Self::never_fires_in) with some leaves pinned
+    /// (the command's parameters): a proof, `false` when unknown.
+    pub fn never_fires_in_given(
+        &self,
+        row: usize,
+        state: StateId,
+        given: &[(LeafId, Value)],
+    ) -> bool {
+        if self.skipped {
+            return false;
+        }
+        let Some(f) = self.fires(row, state) else {
+            return true;
+        };
+        let mut fixed = self.fixed(state);
+        fixed.extend(given.iter().cloned());
+        matches!(self.prove(&f, &fixed), Outcome::None)
+    }
+
     /// Whether the verb's `accept when` is false on a command's arrival
     /// whatever the inputs not `given` (the command's parameters) are: a
     /// proof that such a command is refused; `false` when unknown.

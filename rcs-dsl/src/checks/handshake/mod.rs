@@ -36,6 +36,7 @@ use crate::ir::{
     Target,
 };
 use crate::source::Span;
+use rcs_runtime::driver::Value;
 
 /// What a supervisor's handshake checks read: its plans with their
 /// analyses, and every controller's [`Summary`].
@@ -111,6 +112,10 @@ pub(crate) struct Summary {
     /// The commands with constant arguments its supervisor sends it that
     /// it always answers `ERROR` at once.
     rejected: Vec<rejected::Rejected>,
+    /// For each command with constant arguments its supervisor sends it,
+    /// the statuses its plan makes visible with those arguments (as
+    /// `reported`, with the parameters pinned).
+    pub(super) reported_with: Vec<(CommandId, Vec<Value>, Vec<StatusId>)>,
 }
 
 impl Summary {
@@ -159,7 +164,7 @@ impl Summary {
             })
             .collect();
         let reported = plans()
-            .map(|((plan, conditions), graph)| reported_by(plan, conditions, graph))
+            .map(|((plan, conditions), graph)| reported_by(plan, conditions, graph, &[]))
             .collect();
         let overwritten = c
             .plans
@@ -182,13 +187,25 @@ impl Summary {
                     })
             })
             .collect();
+        let sent = rejected::constant_sends(ir, c);
+        let reported_with = sent
+            .iter()
+            .filter_map(|(verb, args)| {
+                let pid = c.commands[verb.index()].plan?.index();
+                let an = &conditions[pid];
+                let given = rejected::pinned(an, args);
+                let shown = reported_by(&c.plans[pid], an, &graphs[pid], &given);
+                Some((*verb, args.clone(), shown))
+            })
+            .collect();
         Summary {
             failures,
             refusals,
             reported,
             overwritten,
             answers_at_once,
-            rejected: rejected::rejections(ir, c, conditions),
+            rejected: rejected::rejections(c, conditions, &sent),
+            reported_with,
         }
     }
 }
@@ -350,8 +367,13 @@ fn overwritten_reports(r: &Row) -> Vec<(StatusId, Span, Span)> {
 }
 
 /// The statuses the rows of `plan` that can fire make visible, in row
-/// order, without repeats.
-fn reported_by(plan: &Plan, conditions: &PlanAnalysis, graph: &Analysis) -> Vec<StatusId> {
+/// order, without repeats; with `given`, the command's parameters pinned.
+fn reported_by(
+    plan: &Plan,
+    conditions: &PlanAnalysis,
+    graph: &Analysis,
+    given: &[(usize, Value)],
+) -> Vec<StatusId> {
     let mut reported = Vec::new();
     let mut add = |s: StatusId| {
         if !reported.contains(&s) {
@@ -360,8 +382,15 @@ fn reported_by(plan: &Plan, conditions: &PlanAnalysis, graph: &Analysis) -> Vec<
     };
     for (i, r) in plan.rows.iter().enumerate() {
         let can_fire = !graph.never_matches[i]
-            && (0..plan.states.len())
-                .any(|s| graph.reachable[s] && !conditions.never_fires_in(i, StateId(s as u32)));
+            && (0..plan.states.len()).any(|s| {
+                let state = StateId(s as u32);
+                graph.reachable[s]
+                    && if given.is_empty() {
+                        !conditions.never_fires_in(i, state)
+                    } else {
+                        !conditions.never_fires_in_given(i, state, given)
+                    }
+            });
         if !can_fire {
             continue;
         }

@@ -31,13 +31,10 @@ pub(crate) struct Rejected {
     refused: bool,
 }
 
-/// The commands with constant arguments `c`'s supervisor sends it that
-/// `c` always rejects, proved on `c`'s plans.
-pub(crate) fn rejections(ir: &Ir, c: &Controller, conditions: &[PlanAnalysis]) -> Vec<Rejected> {
-    let Some(sup) = c.supervisor else {
-        return Vec::new();
-    };
-    let Some(me) = ir.controller_by_name(&c.name) else {
+/// The commands with constant arguments `c`'s supervisor sends it, without
+/// repeats, in the order written.
+pub(crate) fn constant_sends(ir: &Ir, c: &Controller) -> Vec<(CommandId, Vec<Value>)> {
+    let (Some(sup), Some(me)) = (c.supervisor, ir.controller_by_name(&c.name)) else {
         return Vec::new();
     };
     let mut sent: Vec<(CommandId, Vec<Value>)> = Vec::new();
@@ -52,8 +49,32 @@ pub(crate) fn rejections(ir: &Ir, c: &Controller, conditions: &[PlanAnalysis]) -
             }
         }
     }
+    sent
+}
+
+/// The command's parameters pinned to `args`, as leaves of `an` (those
+/// its conditions read).
+pub(crate) fn pinned(an: &PlanAnalysis, args: &[Value]) -> Vec<(usize, Value)> {
+    args.iter()
+        .enumerate()
+        .filter_map(|(k, v)| {
+            let leaf = an
+                .terms()
+                .find(&Leaf::Param(ParamId(k as u32), Vec::new()))?;
+            Some((leaf, v.clone()))
+        })
+        .collect()
+}
+
+/// Of `sent`, the commands `c` always rejects, proved on `c`'s plans.
+pub(crate) fn rejections(
+    c: &Controller,
+    conditions: &[PlanAnalysis],
+    sent: &[(CommandId, Vec<Value>)],
+) -> Vec<Rejected> {
     let mut out = Vec::new();
     for (verb, args) in sent {
+        let (verb, args) = (*verb, args.clone());
         let Some(pid) = c.commands[verb.index()].plan else {
             continue;
         };
@@ -63,16 +84,7 @@ pub(crate) fn rejections(ir: &Ir, c: &Controller, conditions: &[PlanAnalysis]) -
             continue;
         }
         let an = &conditions[pid.index()];
-        let given: Vec<_> = args
-            .iter()
-            .enumerate()
-            .filter_map(|(k, v)| {
-                let leaf = an
-                    .terms()
-                    .find(&Leaf::Param(ParamId(k as u32), Vec::new()))?;
-                Some((leaf, v.clone()))
-            })
-            .collect();
+        let given = pinned(an, &args);
         let Some(rows) = an.always_rejects(&given) else {
             continue;
         };
@@ -94,7 +106,7 @@ pub(crate) fn rejections(ir: &Ir, c: &Controller, conditions: &[PlanAnalysis]) -
 }
 
 /// A send to `x` whose arguments are all constants: (verb, values).
-fn constant_send(j: &Job, x: crate::ir::CtrlId) -> Option<(CommandId, Vec<Value>)> {
+pub(crate) fn constant_send(j: &Job, x: crate::ir::CtrlId) -> Option<(CommandId, Vec<Value>)> {
     let Job::Send {
         sub, command, args, ..
     } = j

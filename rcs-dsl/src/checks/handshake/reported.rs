@@ -28,7 +28,7 @@ pub(crate) fn check_status_never_reported(
             continue;
         }
         let sent = verbs_sent_by(c, x);
-        let Some(reported) = statuses_reported(ir, summaries, x, &sent) else {
+        let Some((reported, for_any)) = statuses_reported(ir, c, summaries, x, &sent) else {
             continue;
         };
         for p in &c.plans {
@@ -44,13 +44,28 @@ pub(crate) fn check_status_never_reported(
                     {
                         continue;
                     }
-                    let hidden = hidden_report(ir, summaries, x, &sent, status);
-                    let d = never_reported(ir, c, x, &sent, status, span, hidden);
+                    let why = match hidden_report(ir, summaries, x, &sent, status) {
+                        Some((report, by)) => Unseen::Replaced { report, by },
+                        None if for_any.contains(&status) => Unseen::NotWithArgs,
+                        None => Unseen::NoRow,
+                    };
+                    let d = never_reported(ir, c, x, &sent, status, span, why);
                     sink.lint(Some(c), Some(p), d);
                 }
             }
         }
     }
+}
+
+/// Why a supervisor never sees a status.
+#[derive(Clone, Copy)]
+enum Unseen {
+    /// No row that can fire reports it.
+    NoRow,
+    /// A row reports it, and a later write of the same row replaces it.
+    Replaced { report: Span, by: Span },
+    /// Rows report it, but none can fire with the constant arguments sent.
+    NotWithArgs,
 }
 
 fn never_reported(
@@ -60,8 +75,13 @@ fn never_reported(
     sent: &[CommandId],
     status: StatusId,
     span: Span,
-    hidden: Option<(Span, Span)>,
+    why: Unseen,
 ) -> Diagnostic {
+    let hidden = match why {
+        Unseen::Replaced { report, by } => Some((report, by)),
+        _ => None,
+    };
+    let by_args = matches!(why, Unseen::NotWithArgs);
     let xc = ir.controller(x);
     let sub = &xc.name;
     let name = &xc.statuses[status.index()].name;
@@ -77,6 +97,13 @@ fn never_reported(
         format!(
             "`{}` never sends `{sub}` a command, so `{sub}` shows `NOT_READY` for ever",
             c.name
+        )
+    } else if by_args {
+        format!(
+            "`{}` sends {} with constant arguments only, and with those values no row of \
+             `{sub}` that reports `{name}` can fire",
+            c.name,
+            verbs.join(", ")
         )
     } else if hidden.is_some() {
         format!(
@@ -118,23 +145,61 @@ fn never_reported(
 }
 
 /// The statuses `x` makes visible, in the plans `x` runs for `verbs`;
-/// `None` when a verb has no plan (nothing to judge).
+/// `None` when a verb has no plan (nothing to judge). A verb `c` only
+/// ever sends with constant arguments counts the statuses `x` makes
+/// visible with those arguments; the second list counts every value.
 fn statuses_reported(
     ir: &Ir,
+    c: &Controller,
     summaries: &[Summary],
     x: CtrlId,
     verbs: &[CommandId],
-) -> Option<Vec<StatusId>> {
+) -> Option<(Vec<StatusId>, Vec<StatusId>)> {
+    let s = &summaries[x.index()];
     let mut reported = Vec::new();
+    let mut for_any = Vec::new();
     for v in verbs {
         let pid = ir.controller(x).commands[v.index()].plan?.index();
-        for s in &summaries[x.index()].reported[pid] {
-            if !reported.contains(s) {
-                reported.push(*s);
+        let shown = sent_with(c, x, *v, s).unwrap_or_else(|| s.reported[pid].clone());
+        for st in shown {
+            if !reported.contains(&st) {
+                reported.push(st);
+            }
+        }
+        for &st in &s.reported[pid] {
+            if !for_any.contains(&st) {
+                for_any.push(st);
             }
         }
     }
-    Some(reported)
+    Some((reported, for_any))
+}
+
+/// When every send of `verb` from `c` to `x` has constant arguments: the
+/// statuses `x` makes visible with them. `None` otherwise.
+fn sent_with(c: &Controller, x: CtrlId, verb: CommandId, s: &Summary) -> Option<Vec<StatusId>> {
+    let mut shown = Vec::new();
+    for p in &c.plans {
+        for r in &p.rows {
+            for j in &r.jobs {
+                if j.sends_to().is_none_or(|(sub, _)| sub != x)
+                    || !j.commands_sent().contains(&verb)
+                {
+                    continue;
+                }
+                let (v, args) = super::rejected::constant_send(j, x)?;
+                if v != verb {
+                    return None;
+                }
+                let (.., with) = s
+                    .reported_with
+                    .iter()
+                    .find(|(w, a, _)| *w == verb && *a == args)?;
+                shown.extend(with.iter().copied());
+            }
+        }
+    }
+    Some(shown)
 }
 
 /// A `report status` of `x`'s plans for `verbs` that a later write of its

@@ -25,19 +25,22 @@ pub(crate) fn check_stale_subordinate_status(sup: &Supervisor, sink: &mut Sink) 
     let (ir, summaries) = (sup.ir, sup.summaries);
     let c = sup.controller();
     for (p, an, graph) in sup.plans(true) {
+        // Paths to each state, searched once a candidate needs one.
+        let paths = std::cell::OnceCell::new();
         for &x in &c.subordinates {
             if verbs_sent(&p.rows, x).is_empty() {
                 continue;
             }
-            let shown = answers(ir, c, x, summaries);
             let Some(leaf) = an.terms().find(&Leaf::SubStatus(x)) else {
                 continue;
             };
+            let shown = answers(ir, c, x, summaries);
+            // The states the plan can be in before it commands X, by the
+            // graph alone; a run is searched only for a row there.
             let before = uncommanded(p, an, graph, x);
             // One finding per row: the first state where it reads an old answer.
             let mut reported = vec![false; p.rows.len()];
-            for (s, way) in before.iter().enumerate() {
-                let Some(way) = way else { continue };
+            for (s, _) in before.iter().enumerate().filter(|(_, b)| **b) {
                 let state = StateId(s as u32);
                 for (i, r) in p.rows.iter().enumerate() {
                     if reported[i] || !covers(&r.from, state) {
@@ -47,6 +50,10 @@ pub(crate) fn check_stale_subordinate_status(sup: &Supervisor, sink: &mut Sink) 
                         if reported[i] || !shown.contains(&status) {
                             continue;
                         }
+                        let Some(way) = way_to(p, an, &paths, s, x) else {
+                            continue;
+                        };
+                        let way = &way;
                         let Some(mut pins) = an.pins_after(way, 0) else {
                             continue;
                         };
@@ -125,33 +132,55 @@ fn answers(ir: &Ir, c: &crate::ir::Controller, x: CtrlId, summaries: &[Summary])
     shown
 }
 
-/// Per state: a replayed run that reaches it from the command's arrival
-/// along rows that do not command `x` (`S0`: the empty run, before the
-/// first cycle); `None` where no such way is known.
-fn uncommanded(p: &Plan, an: &PlanAnalysis, graph: &Analysis, x: CtrlId) -> Vec<Option<Run>> {
-    let paths = an.paths();
-    let mut ways: Vec<Option<Run>> = vec![None; p.states.len()];
-    if let Some(Some(empty)) = paths.first() {
-        ways[0] = Some(empty.clone());
+/// Per state: whether the plan can be in it before it has commanded `x`,
+/// from the command's arrival along rows that do not command `x` and that
+/// the analysis does not rule out (an over-approximation; each finding is
+/// then shown by a replayed run).
+fn uncommanded(p: &Plan, an: &PlanAnalysis, graph: &Analysis, x: CtrlId) -> Vec<bool> {
+    let mut before = vec![false; p.states.len()];
+    if before.is_empty() {
+        return before;
     }
-    for (s, path) in paths.iter().enumerate().skip(1) {
-        let Some(path) = path else { continue };
-        if !graph.reachable[s] {
-            continue;
-        }
-        // The way there fires only rows that do not command `x`.
-        let clean = path.steps.iter().all(|step| {
-            let fired = step.expect.fired_rows();
-            fired.iter().all(|name| {
-                p.rows
-                    .iter()
-                    .find(|r| row_name(r) == *name)
-                    .is_some_and(|r| !sends(r, x))
-            })
-        });
-        if clean {
-            ways[s] = Some(path.clone());
+    before[0] = true;
+    let mut queue = vec![StateId::S0];
+    while let Some(at) = queue.pop() {
+        for (i, r) in p.rows.iter().enumerate() {
+            let Target::State(to) = r.to else { continue };
+            if before[to.index()]
+                || sends(r, x)
+                || graph.never_matches[i]
+                || !covers(&r.from, at)
+                || an.never_fires_in(i, at)
+            {
+                continue;
+            }
+            before[to.index()] = true;
+            queue.push(to);
         }
     }
-    ways
+    before
+}
+
+/// A replayed run that leaves the plan in state `s` having fired only rows
+/// that do not command `x` (`S0`: the empty run, before the first cycle).
+fn way_to(
+    p: &Plan,
+    an: &PlanAnalysis,
+    paths: &std::cell::OnceCell<Vec<Option<Run>>>,
+    s: usize,
+    x: CtrlId,
+) -> Option<Run> {
+    if s == 0 {
+        return Some(an.empty_run());
+    }
+    let path = paths.get_or_init(|| an.paths()).get(s)?.as_ref()?;
+    let clean = path.steps.iter().all(|step| {
+        step.expect.fired_rows().iter().all(|name| {
+            p.rows
+                .iter()
+                .find(|r| row_name(r) == *name)
+                .is_some_and(|r| !sends(r, x))
+        })
+    });
+    clean.then(|| path.clone())
 }

@@ -25,10 +25,14 @@ pub enum Lint {
     StatusNeverReported,
     IndexRange,
     TimerResolution,
+    IntWrap,
+    DivByZero,
+    NanPath,
+    ReadBeforeAssign,
 }
 
 impl Lint {
-    pub const ALL: [Lint; 16] = [
+    pub const ALL: [Lint; 20] = [
         Lint::RuleOfTen,
         Lint::ShadowedRow,
         Lint::UnreachableState,
@@ -45,6 +49,10 @@ impl Lint {
         Lint::StatusNeverReported,
         Lint::IndexRange,
         Lint::TimerResolution,
+        Lint::IntWrap,
+        Lint::DivByZero,
+        Lint::NanPath,
+        Lint::ReadBeforeAssign,
     ];
 
     pub fn name(self) -> &'static str {
@@ -65,6 +73,10 @@ impl Lint {
             Lint::StatusNeverReported => "status_never_reported",
             Lint::IndexRange => "index_range",
             Lint::TimerResolution => "timer_resolution",
+            Lint::IntWrap => "int_wrap",
+            Lint::DivByZero => "div_by_zero",
+            Lint::NanPath => "nan_path",
+            Lint::ReadBeforeAssign => "read_before_assign",
         }
     }
 

@@ -147,9 +147,15 @@ pub fn stale_reads(
     out
 }
 
-/// `prefix`, then each row of `an`'s plan that ends the command from
-/// `state` (`Done`, `Error`) and sets a var of `candidates`, fired (after
-/// a wait for a counter if it needs one) and replayed.
+/// How many firings of a row that stays and sets a var the earlier
+/// commands try (the runs cut after each of these counts).
+const LOOPS: [usize; 6] = [1, 2, 3, 4, 8, 16];
+
+/// `prefix`, then each row of `an`'s plan that sets a var of
+/// `candidates` from `state`, fired (after a wait for a counter if it
+/// needs one) and replayed: a row that ends the command (`-> Error {
+/// failed = true }`) once, a row that stays (`-> same { tries += 1 }`)
+/// held for a few firings.
 fn ending_runs(
     ir: &Ir,
     an: &PlanAnalysis,
@@ -158,18 +164,14 @@ fn ending_runs(
     state: StateId,
     candidates: &[(usize, VarId)],
 ) -> Vec<Run> {
-    use crate::ir::Target;
     let mut out = Vec::new();
     let Some(waits) = an.waits_after(prefix) else {
         return out;
     };
+    let start: usize = prefix.steps.iter().map(|s| s.cycles.max(1) as usize).sum();
     for (r, row) in an.plan.rows.iter().enumerate() {
-        let ends = matches!(row.to, Target::Done | Target::Error(_) | Target::ErrorOf(_));
-        let sets = row
-            .jobs
-            .iter()
-            .any(|j| candidates.iter().any(|(_, v)| assigns(j, *v)));
-        if !ends || !sets || !row.applies_in(state) {
+        let sets = row.jobs.iter().any(|j| candidates.iter().any(|(_, v)| assigns(j, *v)));
+        if !sets || !row.applies_in(state) || (prefix.steps.is_empty() && state != StateId::S0) {
             continue;
         }
         for &wait in &waits {
@@ -179,22 +181,32 @@ fn ending_runs(
             let Answer::Can(w) = an.can_fire_in_given(r, state, &fixed) else {
                 continue;
             };
-            let probe = Expect::Stays { state: "S0".into() };
-            let Some(mut run) = an.step_run(prefix, &w, wait + 1, probe) else {
+            let probe = Expect::Stays {
+                state: "S0".into(),
+            };
+            let held = wait + LOOPS[LOOPS.len() - 1] as u32;
+            let Some(run) = an.step_run(prefix, &w, held, probe) else {
                 continue;
             };
-            let Some(last) = trace(ir, ctrl, &run).and_then(|t| t.records.last().cloned()) else {
+            let Some(t) = trace(ir, ctrl, &run) else {
                 continue;
             };
-            if last.fired.map(usize::from) != Some(r) {
-                continue;
+            let recs = &t.records;
+            // The cycles on which row `r` fired, from the probed step on.
+            let fired: Vec<usize> = (start..recs.len())
+                .filter(|&k| recs[k].fired.map(usize::from) == Some(r))
+                .collect();
+            let mut any = false;
+            for n in LOOPS {
+                let Some(&end) = fired.get(n - 1) else { break };
+                if let Some(cut) = an.cut(prefix, &w, recs, start, end, end, None) {
+                    if replay_on(ir, ctrl, &cut).is_ok() {
+                        out.push(cut);
+                        any = true;
+                    }
+                }
             }
-            let Some(step) = run.steps.last().and_then(|s| with_expect(an, s, &last)) else {
-                continue;
-            };
-            *run.steps.last_mut().expect("a step") = step;
-            if replay_on(ir, ctrl, &run).is_ok() {
-                out.push(run);
+            if any {
                 break;
             }
         }

@@ -40,6 +40,7 @@
 
 pub mod probe;
 mod sink;
+mod sites;
 pub mod stale;
 
 use super::run::{json_of, replay_on, row_name, Expect, Firing, Run, RunStep};
@@ -54,6 +55,10 @@ pub use sink::Sink;
 /// How many cycles a probe holds a row's inputs, watching for an event:
 /// a `u8` counter stepping by one wraps within it.
 pub const HOLD: u32 = 300;
+
+/// The hold of a probe whose operations read no var: the event, if any,
+/// is on the row's first firing; the cycles after show where it goes.
+const SHORT_HOLD: u32 = 4;
 
 /// The most probes (a row's inputs held from a state) per plan.
 const MAX_PROBES: usize = 64;
@@ -96,18 +101,23 @@ impl PlanAnalysis<'_> {
             .plans
             .first()
             .is_some_and(|p| std::ptr::eq(p, self.plan));
-        let every = first
-            && self
-                .ctrl
-                .every_cycle_jobs()
-                .any(|j| has_operation(std::slice::from_ref(j)));
-        let probed: Vec<bool> = self
+        let every_ops = first.then(|| {
+            let jobs: Vec<Job> = self.ctrl.every_cycle_jobs().cloned().collect();
+            sites::operations(self.ctrl, &jobs)
+        });
+        let every = every_ops.is_some_and(|(any, _)| any);
+        // Per row: whether to probe it, and for how many cycles.
+        let holds: Vec<Option<u32>> = self
             .plan
             .rows
             .iter()
-            .map(|r| every || has_operation(&r.jobs))
+            .map(|r| {
+                let (any, accumulates) = sites::operations(self.ctrl, &r.jobs);
+                let accumulates = accumulates || every_ops.is_some_and(|(_, a)| a);
+                (any || every).then_some(if accumulates { HOLD } else { SHORT_HOLD })
+            })
             .collect();
-        if !probed.contains(&true) {
+        if holds.iter().all(Option::is_none) {
             return Vec::new();
         }
         let paths = self.paths();
@@ -117,7 +127,8 @@ impl PlanAnalysis<'_> {
             let Some(prefix) = prefix else { continue };
             let state = StateId(s as u32);
             for (r, row) in self.plan.rows.iter().enumerate() {
-                if !probed[r] || !row.applies_in(state) {
+                let Some(hold) = holds[r] else { continue };
+                if !row.applies_in(state) {
                     continue;
                 }
                 for hint in self.hints(r, prefix.steps.is_empty(), every) {
@@ -125,7 +136,7 @@ impl PlanAnalysis<'_> {
                         return found;
                     }
                     probes += 1;
-                    for f in self.probe(ctrl, prefix, state, r, &hint) {
+                    for f in self.probe(ctrl, prefix, state, r, &hint, hold) {
                         if !found.iter().any(|g| g.kind == f.kind && g.span == f.span) {
                             found.push(f);
                         }
@@ -145,6 +156,7 @@ impl PlanAnalysis<'_> {
         state: StateId,
         r: usize,
         hint: &[(Leaf, Value)],
+        hold: u32,
     ) -> Vec<ValueFinding> {
         let Some(waits) = self.waits_after(prefix) else {
             return Vec::new();
@@ -168,7 +180,7 @@ impl PlanAnalysis<'_> {
                 w.inputs.push((leaf, v));
             }
             let held = Expect::Stays { state: "S0".into() };
-            let Some(run) = self.step_run(prefix, &w, wait + 1 + HOLD, held) else {
+            let Some(run) = self.step_run(prefix, &w, wait + 1 + hold, held) else {
                 return Vec::new();
             };
             let Some(trace) = trace(self.ir, ctrl, &run) else {
@@ -459,33 +471,6 @@ fn hint_of(e: &Expr) -> Option<Vec<(Leaf, Value)>> {
         }
         _ => None,
     }
-}
-
-/// Whether `jobs` compute with an operation that can go wrong: integer
-/// `+ - * / %` or negation, float arithmetic or a built-in on floats.
-pub(crate) fn has_operation(jobs: &[Job]) -> bool {
-    let mut found = false;
-    for j in jobs {
-        if let Job::Assign { op, place, .. } = j {
-            let numeric = matches!(place.ty, Type::Int(_) | Type::Float(_));
-            found |= numeric && *op != crate::ast::AssignOp::Set;
-        }
-    }
-    crate::ir::visit_job_exprs(jobs, &mut |e| {
-        found |= match &e.kind {
-            ExprKind::Binary(op, _) => {
-                use crate::ast::BinOp;
-                matches!(
-                    op,
-                    BinOp::Add | BinOp::Sub | BinOp::Mul | BinOp::Div | BinOp::Rem
-                )
-            }
-            ExprKind::Unary(crate::ast::UnOp::Neg, _) => true,
-            ExprKind::Builtin(..) => matches!(e.ty, Type::Float(_)),
-            _ => false,
-        }
-    });
-    found
 }
 
 /// A run played on the interpreter, every cycle's record kept, and the

@@ -170,7 +170,10 @@ fn ending_runs(
     };
     let start: usize = prefix.steps.iter().map(|s| s.cycles.max(1) as usize).sum();
     for (r, row) in an.plan.rows.iter().enumerate() {
-        let sets = row.jobs.iter().any(|j| candidates.iter().any(|(_, v)| assigns(j, *v)));
+        let sets = row
+            .jobs
+            .iter()
+            .any(|j| candidates.iter().any(|(_, v)| assigns(j, *v)));
         if !sets || !row.applies_in(state) || (prefix.steps.is_empty() && state != StateId::S0) {
             continue;
         }
@@ -181,9 +184,7 @@ fn ending_runs(
             let Answer::Can(w) = an.can_fire_in_given(r, state, &fixed) else {
                 continue;
             };
-            let probe = Expect::Stays {
-                state: "S0".into(),
-            };
+            let probe = Expect::Stays { state: "S0".into() };
             let held = wait + LOOPS[LOOPS.len() - 1] as u32;
             let Some(run) = an.step_run(prefix, &w, held, probe) else {
                 continue;

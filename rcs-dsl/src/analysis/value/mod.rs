@@ -457,7 +457,7 @@ fn hint_of(e: &Expr) -> Option<Vec<(Leaf, Value)>> {
                         BinOp::Add if c < 0 => lo - c - 1,
                         BinOp::Sub if c > 0 => lo + c - 1,
                         BinOp::Sub if c < 0 => hi + c + 1,
-                        BinOp::Mul if c > 1 || c < -1 => hi / c.abs() + 1,
+                        BinOp::Mul if !(-1..=1).contains(&c) => hi / c.abs() + 1,
                         _ => return None,
                     };
                     Some(vec![(a, Value::Int(v))])

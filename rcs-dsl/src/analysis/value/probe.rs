@@ -277,14 +277,14 @@ fn operate(op: BinOp, a: Value, b: Value, ty: &Type, span: Span, events: &mut Ve
                 });
             }
         }
-        (Value::Float(x), Value::Float(y), Value::Float(r)) => {
-            if r.is_nan() && !x.is_nan() && !y.is_nan() {
-                events.push(Event {
-                    kind: Kind::Nan,
-                    span,
-                    text: text(),
-                });
-            }
+        (Value::Float(x), Value::Float(y), Value::Float(r))
+            if r.is_nan() && !x.is_nan() && !y.is_nan() =>
+        {
+            events.push(Event {
+                kind: Kind::Nan,
+                span,
+                text: text(),
+            });
         }
         _ => {}
     }

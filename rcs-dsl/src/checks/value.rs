@@ -94,7 +94,7 @@ fn report(ir: &Ir, c: &Controller, p: &Plan, f: &ValueFinding, sink: &mut Sink) 
 /// `read_before_assign`: see [`crate::analysis::value::stale`].
 fn check_read_before_assign(ir: &Ir, c: &Controller, analyses: &[PlanAnalysis], sink: &mut Sink) {
     for (p, an) in c.plans.iter().zip(analyses) {
-        for f in crate::analysis::value::stale::stale_reads(ir, c, analyses, an) {
+        for f in crate::analysis::value::stale::stale_reads(ir, c, an) {
             let row = &p.rows[f.row];
             let var = &c.vars[f.var.index()];
             let d = Diagnostic::lint(

@@ -4,9 +4,12 @@
 //! the plan takes another row than it would on a fresh controller?
 //!
 //! Candidates are found from the IR: a var that some job of the plan
-//! assigns (and `pre`/`post` do not), read by the condition of a row that covers `S0`. The earlier command is a
-//! path of any plan of the controller ([`PlanAnalysis::paths`]) that
-//! leaves the var changed from its initial value, replayed. The conditions
+//! assigns (and `pre`/`post` do not), read by the condition of a row
+//! that covers `S0`. The earlier command is a run of the same plan — a
+//! path ([`PlanAnalysis::paths`]), or one continued by a row that ends
+//! the command or stays and counts — that leaves the var changed from its
+//! initial value, replayed; a value another plan leaves is a setting
+//! carried on purpose, and not looked at. The conditions
 //! analysis then gives inputs under which that row fires on the arrival
 //! cycle of this plan's command with the vars as the earlier command left
 //! them; the same inputs on a fresh controller are played too. Only when
@@ -41,14 +44,9 @@ pub struct StaleRead {
     pub run: Run,
 }
 
-/// The stale reads of the plan of `an`, one per row and var at most;
-/// `all` are the analyses of every plan of `c`, in plan order.
-pub fn stale_reads(
-    ir: &Ir,
-    c: &Controller,
-    all: &[PlanAnalysis],
-    an: &PlanAnalysis,
-) -> Vec<StaleRead> {
+/// The stale reads of the plan of `an` (of controller `c`), one per row
+/// and var at most.
+pub fn stale_reads(ir: &Ir, c: &Controller, an: &PlanAnalysis) -> Vec<StaleRead> {
     let plan = an.plan;
     if !an.analysed() || plan.states.is_empty() {
         return Vec::new();
@@ -89,10 +87,11 @@ pub fn stale_reads(
         Vec<rcs_runtime::driver::Value>,
         Vec<rcs_runtime::driver::Value>,
     )> = Vec::new();
-    for other in all {
-        if !other.analysed() {
-            continue;
-        }
+    // Runs of this same plan only: a value another plan leaves is a
+    // setting carried on purpose (a HOME that leaves `homed` for MOVE),
+    // not this plan's stale state.
+    {
+        let other = an;
         let paths = other.paths();
         let mut runs: Vec<Run> = Vec::new();
         for (s, run) in paths.iter().enumerate() {

@@ -21,18 +21,17 @@ pub(crate) fn check_values(ir: &Ir, c: &Controller, analyses: &[PlanAnalysis], s
     for (p, an) in c.plans.iter().zip(analyses) {
         for f in an.value_findings() {
             if f.unit != Unit::Pre && f.unit != Unit::Post {
-                report(ir, c, p, &f, sink);
+                report(c, p, &f, sink);
             } else if !every_cycle_seen.contains(&(f.kind, f.span)) {
                 every_cycle_seen.push((f.kind, f.span));
-                report(ir, c, p, &f, sink);
+                report(c, p, &f, sink);
             }
         }
     }
     check_read_before_assign(ir, c, analyses, sink);
 }
 
-fn report(ir: &Ir, c: &Controller, p: &Plan, f: &ValueFinding, sink: &mut Sink) {
-    let _ = ir;
+fn report(c: &Controller, p: &Plan, f: &ValueFinding, sink: &mut Sink) {
     let place = match f.unit {
         Unit::Pre => format!("`pre` of `{}`", c.name),
         Unit::Post => format!("`post` of `{}`", c.name),

@@ -277,3 +277,47 @@ fn an_unwritable_witnesses_folder_exits_2() {
     assert!(stderr.contains("error: cannot write"), "{stderr}");
     assert!(stderr.contains("taken"), "{stderr}");
 }
+
+/// The value lints' golden cases (`err/50NN_*`): each finding's run is
+/// written by `--witnesses` under the lint's name and `rcsc test` passes
+/// it — the wrapped or zero-divided value expected where the scenario can
+/// write it, the NaN latch as cycles with no row firing, the stale read
+/// as two commands.
+#[test]
+fn value_lint_witnesses_replay_in_rcsc_test() {
+    let mut cases: Vec<String> = std::fs::read_dir("tests/data/err")
+        .unwrap()
+        .map(|e| e.unwrap().path().to_string_lossy().into_owned())
+        .filter(|p| p.contains("/50") && p.ends_with(".rcs"))
+        .collect();
+    cases.sort();
+    assert!(cases.len() >= 16, "only {} value-lint cases", cases.len());
+    let mut with_vars = 0;
+    for (i, case) in cases.iter().enumerate() {
+        let lint = ["int_wrap", "div_by_zero", "nan_path", "read_before_assign"]
+            .into_iter()
+            .find(|l| case.contains(l))
+            .unwrap_or_else(|| panic!("{case}: names no value lint"));
+        let dir = scratch(&format!("value-witnesses{i}"), &[]);
+        let out = rcsc(&["check", case, "--witnesses", dir.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(0), "{case}: {}", text(&out.stderr));
+        let files: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(files.len(), 1, "{case}: {files:?}");
+        let name = Path::new(&files[0]).file_name().unwrap().to_string_lossy();
+        assert!(name.starts_with(&format!("{lint}_")), "{case}: {name}");
+        let body = std::fs::read_to_string(&files[0]).unwrap();
+        with_vars += usize::from(body.contains("    vars:"));
+        let out = rcsc(&["test", case, &files[0]]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{case}: {}{}",
+            text(&out.stdout),
+            text(&out.stderr)
+        );
+    }
+    assert!(with_vars >= 5, "only {with_vars} runs expect the value");
+}

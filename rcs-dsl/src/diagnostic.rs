@@ -225,6 +225,18 @@ impl Code {
             Code::Lint(Lint::TimerResolution) => {
                 "a duration is not a whole number of the CPU's periods: the comparison fires later than written"
             }
+            Code::Lint(Lint::IntWrap) => {
+                "an integer job wraps, and the wrapped value reaches a condition, a send or an output"
+            }
+            Code::Lint(Lint::DivByZero) => {
+                "a divisor can be 0 (the quotient is then 0) where the result reaches a condition, a send or an output"
+            }
+            Code::Lint(Lint::NanPath) => {
+                "a float becomes NaN and then latches the plan in its state, or is sent or published"
+            }
+            Code::Lint(Lint::ReadBeforeAssign) => {
+                "a row reads a var the command's jobs set later, while it still holds an earlier command's value"
+            }
             Code::EveryCycleDecision => {
                 "a `pre` or `post` block sends, reports or changes state: decisions belong in the rows"
             }

@@ -28,10 +28,14 @@ pub enum Lint {
     AlwaysRejected,
     IndexRange,
     TimerResolution,
+    IntWrap,
+    DivByZero,
+    NanPath,
+    ReadBeforeAssign,
 }
 
 impl Lint {
-    pub const ALL: [Lint; 19] = [
+    pub const ALL: [Lint; 23] = [
         Lint::RuleOfTen,
         Lint::ShadowedRow,
         Lint::UnreachableState,
@@ -51,6 +55,10 @@ impl Lint {
         Lint::AlwaysRejected,
         Lint::IndexRange,
         Lint::TimerResolution,
+        Lint::IntWrap,
+        Lint::DivByZero,
+        Lint::NanPath,
+        Lint::ReadBeforeAssign,
     ];
 
     pub fn name(self) -> &'static str {
@@ -74,6 +82,10 @@ impl Lint {
             Lint::AlwaysRejected => "always_rejected",
             Lint::IndexRange => "index_range",
             Lint::TimerResolution => "timer_resolution",
+            Lint::IntWrap => "int_wrap",
+            Lint::DivByZero => "div_by_zero",
+            Lint::NanPath => "nan_path",
+            Lint::ReadBeforeAssign => "read_before_assign",
         }
     }
 

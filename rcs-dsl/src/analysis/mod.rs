@@ -54,6 +54,7 @@ pub mod path;
 pub mod run;
 pub mod search;
 pub mod terms;
+pub mod value;
 mod walk;
 
 use crate::ir::{

@@ -269,7 +269,7 @@ impl PlanAnalysis<'_> {
 
     /// The run of [`try_extend`](Self::try_extend) before its replay;
     /// `None` when a scenario cannot give the witness's inputs.
-    fn step_run(
+    pub(super) fn step_run(
         &self,
         prefix: &Run,
         witness: &Witness,

@@ -56,6 +56,35 @@ pub struct RunStep {
     pub status_fields: BTreeMap<String, BTreeMap<String, Json>>,
     pub cycles: u32,
     pub expect: Expect,
+    /// A new command issued before the step's first cycle (a run of
+    /// several commands: `read_before_assign`); the run's own command
+    /// goes before the first step.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub command: Option<RunCommand>,
+    /// Vars the step's last cycle must leave, each whole, by name (a
+    /// wrapped or zero-divided value that the scenario then checks).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub expect_vars: BTreeMap<String, Json>,
+}
+
+/// A command and its parameters, by name.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct RunCommand {
+    pub verb: String,
+    pub params: BTreeMap<String, Json>,
+}
+
+impl RunCommand {
+    /// As a scenario writes it: `VERB`, or `{ VERB: { param: value } }`.
+    fn json(&self) -> Json {
+        if self.params.is_empty() {
+            return Json::String(self.verb.clone());
+        }
+        let params: serde_json::Map<String, Json> = self.params.clone().into_iter().collect();
+        let mut m = serde_json::Map::new();
+        m.insert(self.verb.clone(), Json::Object(params));
+        Json::Object(m)
+    }
 }
 
 /// What the cycles of a step must show. Rows go by their display name
@@ -200,15 +229,14 @@ pub fn scenario_text(run: &Run, name: &str, about: &str) -> Result<String, Strin
         status: Option<&'a str>,
         #[serde(skip_serializing_if = "Option::is_none")]
         error: Option<&'a str>,
+        #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+        vars: &'a BTreeMap<String, Json>,
     }
-    let command = if run.params.is_empty() {
-        Json::String(run.command.clone())
-    } else {
-        let params: serde_json::Map<String, Json> = run.params.clone().into_iter().collect();
-        let mut m = serde_json::Map::new();
-        m.insert(run.command.clone(), Json::Object(params));
-        Json::Object(m)
-    };
+    let command = RunCommand {
+        verb: run.command.clone(),
+        params: run.params.clone(),
+    }
+    .json();
     // A run holds a subordinate's status until set again, answering each
     // new command; a scenario step's answer binds only that step, so every
     // step repeats the answers in force.
@@ -251,7 +279,11 @@ pub fn scenario_text(run: &Run, name: &str, about: &str) -> Result<String, Strin
                 subordinates.insert(x.clone(), Json::Object(m));
             }
             StepFile {
-                command: (i == 0).then(|| command.clone()),
+                command: if i == 0 {
+                    Some(command.clone())
+                } else {
+                    s.command.as_ref().map(RunCommand::json)
+                },
                 reads: &s.reads,
                 hooks: &s.hooks,
                 subordinates,
@@ -261,6 +293,7 @@ pub fn scenario_text(run: &Run, name: &str, about: &str) -> Result<String, Strin
                     state,
                     status: ended.then_some("ERROR"),
                     error: ended.then_some("INDEX_RANGE"),
+                    vars: &s.expect_vars,
                 },
             }
         })

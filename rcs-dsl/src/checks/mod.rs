@@ -15,6 +15,7 @@ mod plan;
 mod report;
 mod time;
 mod usage;
+mod value;
 
 use crate::analysis::PlanAnalysis;
 use crate::diagnostic::{Diagnostic, Diagnostics};
@@ -212,6 +213,7 @@ fn analyse_controller<'ir>(ir: &'ir Ir, ci: CtrlId, levels: &LintLevels) -> Anal
     {
         check_plan(ir, c, p, conditions, analysis, out, &mut sink);
     }
+    value::check_values(ir, c, &conditions, &mut sink);
     usage::check_float_equality(c, &mut sink);
     time::check_timer_resolution(ir, ci, &mut sink);
     let uses = usage::check_unused_in_controller(ir, ci, &mut sink);

@@ -55,6 +55,30 @@ pub(crate) fn check_sets(
     }
 }
 
+/// [`check_sets`] for running the plans (`rcsc test`): a set that only
+/// the checks of stage 3 reject (an unreachable row, a lint at deny) still
+/// runs — its diagnostics are printed, and its scenarios, a finding's own
+/// witness among them, decide the outcome. A set that does not parse or
+/// lower stops the run.
+pub(crate) fn check_sets_to_run(
+    sets: &[rcs_dsl::PlanSet],
+    common: &Common,
+) -> Result<Vec<rcs_dsl::ir::Ir>, ExitCode> {
+    let options = common.options();
+    let mut counts = Counts::default();
+    let mut irs = Vec::with_capacity(sets.len());
+    for set in sets {
+        let checked = rcs_dsl::check(set, &options);
+        print_diagnostics(set, &checked, common, false, &mut counts);
+        irs.extend(checked.ir.or(checked.rejected_by_checks));
+    }
+    print_summary(common, &counts);
+    if irs.len() != sets.len() {
+        return Err(ExitCode::from(1));
+    }
+    Ok(irs)
+}
+
 /// [`check_sets`], showing each set's check result to `each` (in the
 /// order of the sets) after its diagnostics are printed.
 pub(crate) fn check_sets_each(

@@ -4,7 +4,7 @@
 //! each like `cargo test` does, and optionally the rows no scenario fired.
 
 use crate::args::*;
-use crate::commands::check_sets;
+use crate::commands::check_sets_to_run;
 use crate::output::*;
 use crate::{compiled, Status};
 use rcs_codegen::site::RunCounts;
@@ -423,7 +423,7 @@ pub(crate) fn test(args: TestArgs) -> ExitCode {
         Ok(p) => p,
         Err(reason) => return fail(reason),
     };
-    let irs = match check_sets(&sets, &args.common, false, None, None) {
+    let irs = match check_sets_to_run(&sets, &args.common) {
         Ok(irs) => irs,
         Err(code) => return code,
     };

@@ -321,3 +321,48 @@ fn value_lint_witnesses_replay_in_rcsc_test() {
     }
     assert!(with_vars >= 5, "only {with_vars} runs expect the value");
 }
+
+/// The runs of the cross-controller findings (err 5101–5160), written by
+/// `--witnesses`, pass `rcsc test` — 5160's too, although its set has an
+/// `unreachable_row` error: `rcsc test` runs a set the checks reject.
+#[test]
+fn cross_controller_witnesses_replay_in_rcsc_test() {
+    let mut cases: Vec<String> = std::fs::read_dir("tests/data/err")
+        .unwrap()
+        .map(|e| e.unwrap().path().to_string_lossy().into_owned())
+        .filter(|p| p.contains("/51"))
+        .collect();
+    cases.sort();
+    assert!(
+        cases.len() >= 20,
+        "only {} cross-controller cases",
+        cases.len()
+    );
+    let mut replayed = 0;
+    let mut with_error = 0;
+    for (i, case) in cases.iter().enumerate() {
+        let dir = scratch(&format!("cross-witnesses{i}"), &[]);
+        let out = rcsc(&["check", case, "--witnesses", dir.to_str().unwrap()]);
+        let files: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path().to_string_lossy().into_owned())
+            .collect();
+        if files.is_empty() {
+            continue;
+        }
+        with_error += usize::from(out.status.code() != Some(0));
+        let mut args = vec!["test", case.as_str()];
+        args.extend(files.iter().map(String::as_str));
+        let out = rcsc(&args);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{case}: {}{}",
+            text(&out.stdout),
+            text(&out.stderr)
+        );
+        replayed += files.len();
+    }
+    assert!(replayed >= 12, "only {replayed} runs replayed");
+    assert!(with_error >= 1, "no case with an error of the checks");
+}

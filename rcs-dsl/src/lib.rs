@@ -68,6 +68,12 @@ pub struct Options {
 pub struct Checked {
     /// Present when no error was found (warnings allowed).
     pub ir: Option<ir::Ir>,
+    /// The IR when only the checks of stage 3 rejected it (an unreachable
+    /// or shadowed row, a lint set to deny): well-formed plans that run on
+    /// the interpreter and compile like any other, which is what replaying
+    /// a finding's own witness needs. `None` when `ir` is present or
+    /// parsing or lowering failed.
+    pub rejected_by_checks: Option<ir::Ir>,
     pub diagnostics: Vec<Diagnostic>,
 }
 
@@ -97,8 +103,12 @@ pub fn check(set: &PlanSet, options: &Options) -> Checked {
         levels.set(lint, level);
     }
     checks::run(&ir, &levels, &set.sources, &mut diags);
-    let ir = (!diags.has_errors()).then_some(ir);
-    finish(ir, diags, &origins)
+    if diags.has_errors() {
+        let mut checked = finish(None, diags, &origins);
+        checked.rejected_by_checks = Some(ir);
+        return checked;
+    }
+    finish(Some(ir), diags, &origins)
 }
 
 /// Parse and lower a plan set without running the checks: the IR even of
@@ -211,6 +221,7 @@ fn parse_all(set: &PlanSet, ids: &[source::FileId]) -> Vec<(ParseResult, paralle
 fn finish(ir: Option<ir::Ir>, diags: Diagnostics, origins: &expand::Origins) -> Checked {
     Checked {
         ir,
+        rejected_by_checks: None,
         diagnostics: expand::attribute(diags.into_vec(), origins),
     }
 }

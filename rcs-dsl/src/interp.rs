@@ -19,6 +19,7 @@ use rcs_runtime::{
 use crate::arith::truthy;
 pub use crate::arith::{checked, float_to_int, round, wrap};
 pub use driven::Driven;
+pub use system::System;
 pub use rcs_runtime::driver::Value;
 pub use value::{conform, zero};
 
@@ -27,6 +28,9 @@ mod driven;
 /// Expressions.
 mod eval;
 mod every_cycle;
+/// Several controllers on their schedule, exchanging through a model of
+/// Global Memory: what system scenarios run on.
+mod system;
 /// Jobs and the places they assign.
 mod jobs;
 /// Zero and conforming values by type.
@@ -172,6 +176,15 @@ impl<'ir> Interpreter<'ir> {
         let serial = self.supervisor.next_command();
         self.command = (serial, command, params);
         serial
+    }
+
+    /// A supervisor that is itself interpreted (a system run,
+    /// [`System`]) wrote `command` with the serial and epoch its own link
+    /// drew: this controller reads that, as from Global Memory.
+    pub fn receive(&mut self, serial: u32, epoch: u32, command: CommandId, params: Vec<Value>) {
+        self.supervisor = SubordinateLink::with_epoch(epoch);
+        self.supervisor.set_last_sent(serial);
+        self.command = (serial, command, params);
     }
 
     /// The supervisor's command buffer as it stands: serial, verb, parameters.

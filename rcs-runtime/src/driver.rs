@@ -14,6 +14,9 @@
 //! is test tooling, never the cycle path of a running system.
 
 use crate::handshake::{ErrorCode, RowId, StateId, Status, StatusBuffer, VerbId};
+
+pub mod system;
+pub use system::DrivenSystem;
 use serde::{Deserialize, Serialize};
 
 /// A value of any plan type, as the interpreter computes it and as the

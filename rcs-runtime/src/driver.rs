@@ -16,7 +16,7 @@
 use crate::handshake::{ErrorCode, RowId, StateId, Status, StatusBuffer, VerbId};
 
 pub mod system;
-pub use system::DrivenSystem;
+pub use system::{DrivenSystem, SystemFactory};
 use serde::{Deserialize, Serialize};
 
 /// A value of any plan type, as the interpreter computes it and as the

@@ -37,3 +37,8 @@ pub trait DrivenSystem {
     /// order (`sent` indexes the controller's own `subordinates`).
     fn run_cpu(&mut self, cpu: &str) -> Result<Vec<(String, Record)>, DriveError>;
 }
+
+/// Makes a fresh generated run of the named controllers (whole subtrees);
+/// `Err` names what is wrong with the list. The generated
+/// `new_system_driver` of each plan set has this type.
+pub type SystemFactory = fn(&[&str]) -> Result<Box<dyn DrivenSystem>, String>;

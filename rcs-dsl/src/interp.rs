@@ -19,8 +19,8 @@ use rcs_runtime::{
 use crate::arith::truthy;
 pub use crate::arith::{checked, float_to_int, round, wrap};
 pub use driven::Driven;
-pub use system::System;
 pub use rcs_runtime::driver::Value;
+pub use system::System;
 pub use value::{conform, zero};
 
 /// The driver interface: [`Driven`], with scripted hooks.
@@ -28,11 +28,11 @@ mod driven;
 /// Expressions.
 mod eval;
 mod every_cycle;
+/// Jobs and the places they assign.
+mod jobs;
 /// Several controllers on their schedule, exchanging through a model of
 /// Global Memory: what system scenarios run on.
 mod system;
-/// Jobs and the places they assign.
-mod jobs;
 /// Zero and conforming values by type.
 mod value;
 /// `X <- cmd`: the command a forward sends.

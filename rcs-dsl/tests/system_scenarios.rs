@@ -27,3 +27,37 @@ fn the_submarine_runs_whole() {
     let out = scenario::run_system(&ir, &s);
     assert!(out.failure.is_none(), "{:?}", out.failure);
 }
+
+#[test]
+fn every_system_scenario_of_the_plans_passes() {
+    let mut ran = 0;
+    for set in [
+        "../plans/submarine",
+        "../plans/rcs_ex",
+        "../plans/packml",
+        "../plans/fieldbus_drive",
+        "../plans/bridgeport_io",
+    ] {
+        let ir = load(set);
+        let mut paths: Vec<_> = std::fs::read_dir(Path::new(set).join("scenarios"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| {
+                p.file_name()
+                    .unwrap()
+                    .to_str()
+                    .unwrap()
+                    .starts_with("system_")
+            })
+            .collect();
+        paths.sort();
+        for p in paths {
+            let s = system(&ir, &std::fs::read_to_string(&p).unwrap())
+                .unwrap_or_else(|(l, m)| panic!("{}:{l}: {m}", p.display()));
+            let out = scenario::run_system(&ir, &s);
+            assert!(out.failure.is_none(), "{}: {:?}", p.display(), out.failure);
+            ran += 1;
+        }
+    }
+    assert!(ran >= 3, "{ran}");
+}

@@ -16,8 +16,8 @@
 use crate::handshake::{ErrorCode, RowId, StateId, Status, StatusBuffer, VerbId};
 
 pub mod system;
-pub use system::{DrivenSystem, SystemFactory};
 use serde::{Deserialize, Serialize};
+pub use system::{DrivenSystem, SystemFactory};
 
 /// A value of any plan type, as the interpreter computes it and as the
 /// generated types convert to and from it ([`ToValue`], [`FromValue`]).

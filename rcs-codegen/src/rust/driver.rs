@@ -269,8 +269,16 @@ pub(crate) fn driver_parts(ir: &Ir, names: &Names, ci: usize, part: DriverPart) 
         quote!(let data = c.data();)
     };
     let (hook_c, var_c) = (
-        if c.hooks.is_empty() { quote!(_) } else { quote!(c) },
-        if c.vars.is_empty() { quote!(_) } else { quote!(c) },
+        if c.hooks.is_empty() {
+            quote!(_)
+        } else {
+            quote!(c)
+        },
+        if c.vars.is_empty() {
+            quote!(_)
+        } else {
+            quote!(c)
+        },
     );
     let before = if c.subordinates.is_empty() {
         quote!()

@@ -192,8 +192,15 @@ fn drive(
         }
         for (b, v) in &step.reads {
             let buf = &ir.buffers[b.index()];
-            let merged = merge(ir, line, &external[b.index()], &Type::Buffer(buf.ty), v, &buf.name)
-                .map_err(|e| (e.line, e.message))?;
+            let merged = merge(
+                ir,
+                line,
+                &external[b.index()],
+                &Type::Buffer(buf.ty),
+                v,
+                &buf.name,
+            )
+            .map_err(|e| (e.line, e.message))?;
             d.set_read(&buf.name, &merged).map_err(fail)?;
             external[b.index()] = merged;
             held[b.index()] = false;

@@ -90,8 +90,14 @@ pub(super) fn is_system(text: &str) -> bool {
         system: Option<serde::de::IgnoredAny>,
         controllers: Option<serde::de::IgnoredAny>,
     }
-    crate::yaml::from_str_names::<Probe>(text)
-        .is_ok_and(|p| p.system.is_some() || p.controllers.is_some())
+    match crate::yaml::from_str_names::<Probe>(text) {
+        Ok(p) => p.system.is_some() || p.controllers.is_some(),
+        // A file that does not read as YAML is judged by its lines, so its
+        // error is the one of its kind's reader.
+        Err(_) => text
+            .lines()
+            .any(|l| l.starts_with("system:") || l.starts_with("controllers:")),
+    }
 }
 
 /// Read and resolve a system scenario. `stem` names it when it has no `name:`.
@@ -173,7 +179,10 @@ pub(super) fn parse_system(
                 ));
             }
             if step.commands.iter().any(|(x, _, _)| *x == c) {
-                return Err(err(cline, format!("`{name}` is commanded twice in one step")));
+                return Err(err(
+                    cline,
+                    format!("`{name}` is commanded twice in one step"),
+                ));
             }
             let (k, args) = verb_call(ir, ir.controller(c), cline, call, || {
                 format!("`commands.{name}` is a verb or `{{ VERB: {{ param: value }} }}`")
@@ -223,7 +232,11 @@ pub(super) fn parse_system(
 /// The controllers of the run, by id order: every one (`system: true`) or
 /// those named, which must hold whole subtrees.
 fn run_of(ir: &Ir, raw: &RawSystem) -> Result<Vec<CtrlId>, ScenarioError> {
-    let all = || (0..ir.controllers.len()).map(|i| CtrlId(i as u32)).collect();
+    let all = || {
+        (0..ir.controllers.len())
+            .map(|i| CtrlId(i as u32))
+            .collect()
+    };
     match (&raw.system, &raw.controllers) {
         (Some(s), Some(_)) => Err(err(
             line_of(s),
@@ -371,9 +384,7 @@ impl SystemResolver<'_> {
                     .hooks
                     .iter()
                     .position(|x| x.name == h.name)
-                    .ok_or_else(|| {
-                        err(h.line, format!("`{name}` has no hook `{}`", h.name))
-                    })?;
+                    .ok_or_else(|| err(h.line, format!("`{name}` has no hook `{}`", h.name)))?;
                 let v = value(self.ir, h.line, &ctrl.hooks[i].ret, &h.value, &h.name)?;
                 out.push((c, HookId(i as u32), v));
             }

@@ -34,7 +34,10 @@ fn run_all() -> Result<(usize, usize), String> {
         let mut ir = None;
         for p in paths {
             let text = std::fs::read_to_string(&p).expect("readable");
-            if !text.lines().any(|l| l.starts_with("system:") || l.starts_with("controllers:")) {
+            if !text
+                .lines()
+                .any(|l| l.starts_with("system:") || l.starts_with("controllers:"))
+            {
                 continue;
             }
             let ir = ir.get_or_insert_with(|| load(set.path));
@@ -56,8 +59,8 @@ fn run_all() -> Result<(usize, usize), String> {
                 &mut rcs_dsl::interp::System::new(ir, &s.controllers),
                 &mut |c, r| interp_trace.push(shown(&ir.controller(c).name, r)),
             );
-            let mut compiled = (set.new_system_driver)(&names)
-                .map_err(|e| format!("{}: {e}", p.display()))?;
+            let mut compiled =
+                (set.new_system_driver)(&names).map_err(|e| format!("{}: {e}", p.display()))?;
             let mut compiled_trace = Vec::new();
             let b = scenario::run_system_on(ir, &s, compiled.as_mut(), &mut |c, r| {
                 compiled_trace.push(shown(&ir.controller(c).name, r))
@@ -74,7 +77,10 @@ fn run_all() -> Result<(usize, usize), String> {
             }
             for (backend, o) in [("interpreter", &a), ("generated code", &b)] {
                 if let Some((line, report)) = &o.failure {
-                    return Err(format!("{}:{line}: fails on the {backend}:\n{report}", p.display()));
+                    return Err(format!(
+                        "{}:{line}: fails on the {backend}:\n{report}",
+                        p.display()
+                    ));
                 }
             }
             scenarios += 1;
@@ -88,5 +94,8 @@ fn run_all() -> Result<(usize, usize), String> {
 fn system_scenarios_run_the_same_on_interpreter_and_generated_code() {
     let (scenarios, cycles) = run_all().unwrap_or_else(|e| panic!("{e}"));
     println!("differential: {scenarios} system scenarios, {cycles} controller cycles compared");
-    assert!(scenarios >= 2, "the system scenarios of plans/ were found ({scenarios})");
+    assert!(
+        scenarios >= 2,
+        "the system scenarios of plans/ were found ({scenarios})"
+    );
 }

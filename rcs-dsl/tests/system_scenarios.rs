@@ -61,3 +61,72 @@ fn every_system_scenario_of_the_plans_passes() {
     }
     assert!(ran >= 3, "{ran}");
 }
+
+/// A wrong expectation fails on its step's line, naming the step, the
+/// controller and the key, expected against actual.
+#[test]
+fn a_wrong_expectation_names_step_controller_and_key() {
+    let ir = load("../plans/submarine");
+    let text = "system: true
+steps:
+  - command: INIT
+  - expect:
+      PR: { fired: E1, status: DONE }
+      TB: { state: S1, status: DONE }
+";
+    let s = system(&ir, text).unwrap();
+    let out = scenario::run_system(&ir, &s);
+    let (line, report) = out.failure.expect("fails");
+    assert_eq!(line, 4);
+    assert_eq!(report, "step 2, TB: state: expected S1, got S0");
+    // The rows of every controller are kept, for the report and coverage.
+    let pr = &out
+        .controllers
+        .iter()
+        .find(|(c, _)| ir.controller(*c).name == "PR")
+        .unwrap()
+        .1;
+    assert_eq!(pr.fired_per_cycle().collect::<Vec<_>>(), ["E0", "E1"]);
+}
+
+#[test]
+fn names_and_shapes_are_refused_with_their_line() {
+    let sub = load("../plans/submarine");
+    let pack = load("../plans/packml");
+    let cases: &[(&rcs_dsl::ir::Ir, &str, usize, &str)] = &[
+        (&sub, "controllers: [SM, PR]\nsteps: []\n", 1, "`TB` is a subordinate of `PR` but not in `controllers`"),
+        (&sub, "controllers: [SM, NOPE]\nsteps: []\n", 1, "unknown controller `NOPE`"),
+        (&sub, "controllers: [TB, TB]\nsteps: []\n", 1, "`TB` is named twice"),
+        (&sub, "controllers: []\nsteps: []\n", 1, "names no controller"),
+        (&sub, "controllers: TB\nsteps: []\n", 1, "a list of controller names"),
+        (&sub, "system: false\nsteps: []\n", 1, "`system` is `true`"),
+        (&sub, "system: true\ncontrollers: [TB]\nsteps: []\n", 1, "not both"),
+        (&sub, "system: true\nsteps:\n  - expect:\n      XX: { state: S1 }\n", 4, "unknown controller `XX`"),
+        (&sub, "controllers: [TB]\nsteps:\n  - expect:\n      PR: { state: S1 }\n", 4, "`PR` is not in this run"),
+        (&sub, "system: true\nsteps:\n  - expect:\n      PR: { state: S9 }\n", 4, "no plan of `PR` has a state `S9`"),
+        (&sub, "system: true\nsteps:\n  - expect:\n      PR: { sent: { SM: INIT } }\n", 4, "`SM` is not a subordinate of `PR`"),
+        (&sub, "system: true\nsteps:\n  - reads: { drive: { engaged: true } }\n", 3, "`drive` is written by `TB`, which is in the run"),
+        (&sub, "controllers: [TB]\nsteps:\n  - reads: { ship: { speed: 1.0 } }\n", 3, "no controller of the run reads `ship`"),
+        (&sub, "system: true\nsteps:\n  - hooks: { required_rpm: 1.0 }\n", 3, "hooks are given per controller: `hooks: { PR: { required_rpm: … } }`"),
+        (&sub, "system: true\nsteps:\n  - hooks: { PR: { nope: 1.0 } }\n", 3, "`PR` has no hook `nope`"),
+        (&sub, "system: true\nsteps:\n  - hooks: { PR: { required_rpm: true } }\n", 3, "expected f64"),
+        (&sub, "system: true\nsteps:\n  - command: AHEAD\n", 3, "`SM` has no command `AHEAD`"),
+        (&sub, "system: true\nsteps:\n  - commands: { PR: INIT }\n", 3, "`PR` is not a root of this run"),
+        (&sub, "system: true\nsteps:\n  - subordinates: { PR: DONE }\n", 3, "unknown field `subordinates`"),
+        (&sub, "system: true\nsteps:\n  - cycles: 0\n", 3, "`cycles` is a whole number"),
+        (&sub, "system: true\ninitial:\n  vars: { PR: { nope: 1 } }\nsteps: []\n", 3, "`PR` has no var `nope`"),
+        (&pack, "controllers: [INFEED, FILLER]\nsteps:\n  - command: RESET\n", 3, "this run has 2 roots (INFEED, FILLER)"),
+        (&pack, "controllers: [INFEED, FILLER]\nsteps:\n  - commands: { INFEED: RESET, INFEED: STOP }\n", 3, "given twice"),
+    ];
+    for (ir, text, line, needle) in cases {
+        let Err((l, m)) = system(ir, text) else {
+            panic!("accepted: {text}");
+        };
+        assert!(m.contains(needle), "{text}\n→ {m}");
+        assert_eq!(l, *line, "{text}\n→ {m}");
+    }
+    // Several roots each take their command by name.
+    let s = system(&pack, "controllers: [INFEED, FILLER]\nsteps:\n  - commands: { INFEED: RESET, FILLER: START }\n    expect:\n      INFEED: { fired: E0, state: S1 }\n      FILLER: { fired: E0, state: S1, writes: { filler_out: { run: true } } }\n").unwrap();
+    let out = scenario::run_system(&pack, &s);
+    assert!(out.failure.is_none(), "{:?}", out.failure);
+}

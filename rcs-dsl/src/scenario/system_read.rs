@@ -30,8 +30,8 @@ struct RawSystem {
 #[serde(deny_unknown_fields)]
 struct RawInitial {
     reads: Option<Entries>,
-    hooks: Option<Keyed<Entries>>,
-    vars: Option<Keyed<Entries>>,
+    hooks: Option<Keyed<Json>>,
+    vars: Option<Keyed<Json>>,
 }
 
 #[derive(Deserialize)]
@@ -42,7 +42,7 @@ struct RawStep {
     /// `{ ROOT: VERB | { VERB: { param: value } } }`, any roots.
     commands: Option<Entries>,
     reads: Option<Entries>,
-    hooks: Option<Keyed<Entries>>,
+    hooks: Option<Keyed<Json>>,
     silent: Option<Spanned<Json>>,
     cycles: Option<Spanned<Json>>,
     expect: Option<Keyed<RawExpect>>,
@@ -132,7 +132,8 @@ pub(super) fn parse_system(
             ir,
             c: ir.controller(c),
         };
-        for (i, v) in res.vars(&Some(vars))? {
+        let vars = Some(per_controller(line, &name, "vars", &vars)?);
+        for (i, v) in res.vars(&vars)? {
             initial.vars.push((c, i, v));
         }
     }
@@ -373,13 +374,29 @@ impl SystemResolver<'_> {
     /// `hooks: { CTRL: { hook: value } }`.
     fn hooks(
         &self,
-        e: &Option<Keyed<Entries>>,
+        e: &Option<Keyed<Json>>,
     ) -> Result<Vec<(CtrlId, HookId, Value)>, ScenarioError> {
         let mut out = Vec::new();
         for (line, name, hooks) in e.as_ref().map_or(&[][..], |k| &k.0) {
+            let owner = self.run.iter().find(|c| {
+                self.ir
+                    .controller(**c)
+                    .hooks
+                    .iter()
+                    .any(|h| h.name == *name)
+            });
+            if let (None, Some(owner)) = (self.ir.controller_by_name(name), owner) {
+                return Err(err(
+                    *line,
+                    format!(
+                        "hooks are given per controller: `hooks: {{ {}: {{ {name}: … }} }}`",
+                        self.ir.controller(*owner).name
+                    ),
+                ));
+            }
             let c = self.controller(*line, name)?;
             let ctrl = self.ir.controller(c);
-            for h in &hooks.0 {
+            for h in per_controller(*line, name, "hooks", hooks)?.0 {
                 let i = ctrl
                     .hooks
                     .iter()
@@ -390,5 +407,26 @@ impl SystemResolver<'_> {
             }
         }
         Ok(out)
+    }
+}
+
+/// The mapping given for one controller (`hooks: { PR: { … } }`), its
+/// entries on the line of the controller's key.
+fn per_controller(line: usize, name: &str, what: &str, v: &Json) -> Result<Entries, ScenarioError> {
+    match v {
+        Json::Object(m) => Ok(Entries(
+            m.iter()
+                .map(|(k, x)| super::read::Entry {
+                    line,
+                    name: k.clone(),
+                    value: x.clone(),
+                })
+                .collect(),
+        )),
+        Json::Null => Ok(Entries::default()),
+        _ => Err(err(
+            line,
+            format!("`{what}.{name}` is a mapping of names to values: `{what}: {{ {name}: {{ name: value }} }}`"),
+        )),
     }
 }

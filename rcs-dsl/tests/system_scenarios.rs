@@ -130,3 +130,116 @@ fn names_and_shapes_are_refused_with_their_line() {
     let out = scenario::run_system(&pack, &s);
     assert!(out.failure.is_none(), "{:?}", out.failure);
 }
+
+/// The programmatic form (what cross-controller witnesses are written
+/// as): built in code, written as a file, read back to the same script,
+/// and run through that file.
+#[test]
+fn a_script_round_trips_through_its_file_and_runs() {
+    use rcs_dsl::interp::Value;
+    use scenario::{ControllerExpect, SystemScript, SystemStep};
+    let ir = load("../plans/submarine");
+    let expect = |c: &str, e: ControllerExpect| (c.to_string(), e);
+    let script = SystemScript {
+        name: "TRANSIT, \"built\" in code".to_string(),
+        controllers: None,
+        initial: SystemStep {
+            reads: vec![(
+                "ship".into(),
+                Value::Buffer(vec![Value::Enum(0), Value::Float(0.1)]),
+            )],
+            hooks: vec![
+                ("PR".into(), "required_rpm".into(), Value::Float(100.0)),
+                ("PR".into(), "speed_error".into(), Value::Enum(1)),
+            ],
+            vars: vec![("PR".into(), "rpm".into(), Value::Float(1e-7))],
+            ..SystemStep::default()
+        },
+        steps: vec![
+            SystemStep {
+                commands: vec![("SM".into(), "TRANSIT".into(), vec![Value::Float(10.0)])],
+                cycles: 1,
+                expect: vec![
+                    expect(
+                        "SM",
+                        ControllerExpect {
+                            fired: Some(Some("E0".into())),
+                            state: Some("S1".into()),
+                            sent: Some(vec![(
+                                "PR".into(),
+                                "AHEAD".into(),
+                                vec![Value::Float(10.0)],
+                            )]),
+                            ..ControllerExpect::default()
+                        },
+                    ),
+                    expect(
+                        "TB",
+                        ControllerExpect {
+                            fired: Some(Some("E0".into())),
+                            status: Some("EXECUTING".into()),
+                            error: Some(None),
+                            ..ControllerExpect::default()
+                        },
+                    ),
+                ],
+                ..SystemStep::default()
+            },
+            SystemStep {
+                reads: vec![("turbine".into(), Value::Buffer(vec![Value::Float(100.0)]))],
+                cycles: 4,
+                expect: vec![
+                    expect(
+                        "PR",
+                        ControllerExpect {
+                            status: Some("AT_GOAL".into()),
+                            vars: vec![
+                                ("rpm".into(), Value::Float(100.0)),
+                                ("ship_speed".into(), Value::Float(0.1)),
+                            ],
+                            sent: Some(vec![]),
+                            ..ControllerExpect::default()
+                        },
+                    ),
+                    expect(
+                        "SM",
+                        ControllerExpect {
+                            fired: Some(None),
+                            state: Some("S2".into()),
+                            ..ControllerExpect::default()
+                        },
+                    ),
+                ],
+                ..SystemStep::default()
+            },
+        ],
+    };
+    let text = script.to_yaml(&ir);
+    let back = SystemScript::from_yaml(&ir, &text, "x")
+        .unwrap_or_else(|e| panic!("{}: {}\n{text}", e.line, e.message));
+    assert_eq!(back, script, "{text}");
+    let out = scenario::run_script(&ir, &script).unwrap();
+    assert!(out.failure.is_none(), "{:?}\n{text}", out.failure);
+
+    // A wrong expectation fails, naming step, controller and key.
+    let mut wrong = script.clone();
+    wrong.steps[1].expect[1].1.state = Some("S1".into());
+    let (line, report) = scenario::run_script(&ir, &wrong)
+        .unwrap()
+        .failure
+        .expect("fails");
+    assert_eq!(report, "step 2, SM: state: expected S1, got S2");
+    assert!(line > 1);
+
+    // A subtree, and a file written by hand, read as a script and back.
+    let path = "../plans/rcs_ex/scenarios/system_prim_servo_subtree.scenario.yaml";
+    let ex = load("../plans/rcs_ex");
+    let s = SystemScript::from_yaml(&ex, &std::fs::read_to_string(path).unwrap(), "x").unwrap();
+    assert_eq!(
+        s.controllers.as_deref(),
+        Some(&["PRIM".to_string(), "SERVO".to_string()][..])
+    );
+    let again = SystemScript::from_yaml(&ex, &s.to_yaml(&ex), "x").unwrap();
+    assert_eq!(again, s);
+    assert!(scenario::run_script(&ex, &s).unwrap().failure.is_none());
+}

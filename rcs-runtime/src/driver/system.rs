@@ -14,7 +14,7 @@
 //! Like the rest of [`super`], this allocates: test tooling, never the
 //! cycle path of a running system.
 
-use super::{DriveError, Record, Value};
+use super::{DriveError, Record, Remote, Request, Response, Value};
 
 /// Several controllers of one plan set, on their real schedule. Names are
 /// as written in the plans.
@@ -42,3 +42,112 @@ pub trait DrivenSystem {
 /// `Err` names what is wrong with the list. The generated
 /// `new_system_driver` of each plan set has this type.
 pub type SystemFactory = fn(&[&str]) -> Result<Box<dyn DrivenSystem>, String>;
+
+/// One system request of the protocol, answered by `d` (the server side,
+/// [`super::serve_systems`]).
+pub(super) fn answer(d: &mut dyn DrivenSystem, request: Request) -> Response {
+    let done = |r: Result<(), DriveError>| r.map_or_else(Response::Refused, |()| Response::Done);
+    match request {
+        Request::SystemCommand { root, verb, args } => d
+            .command(&root, &verb, &args)
+            .map_or_else(Response::Refused, Response::Serial),
+        Request::SystemSetRead { buffer, value } => done(d.set_read(&buffer, &value)),
+        Request::SystemSetHook {
+            controller,
+            hook,
+            value,
+        } => done(d.set_hook(&controller, &hook, &value)),
+        Request::SystemSetVar {
+            controller,
+            var,
+            value,
+        } => done(d.set_var(&controller, &var, &value)),
+        Request::RunCpu { cpu } => d
+            .run_cpu(&cpu)
+            .map_or_else(Response::Refused, Response::Records),
+        _ => Response::Failed("not a system request".to_string()),
+    }
+}
+
+/// A system run driven through the protocol, in another process (the
+/// client side of [`super::serve_systems`]): how `rcsc test --backend
+/// compiled` runs system scenarios. A broken connection is kept in
+/// [`RemoteSystem::failure`]; the calls then return empty answers.
+#[derive(Debug)]
+pub struct RemoteSystem<R, W> {
+    remote: Remote<R, W>,
+}
+
+impl<R: std::io::BufRead, W: std::io::Write> RemoteSystem<R, W> {
+    /// Ask the server for a fresh run of `controllers` of plan set `set`.
+    pub fn open(input: R, output: W, set: usize, controllers: &[&str]) -> Result<Self, String> {
+        let mut remote = Remote {
+            input,
+            output,
+            name: "the run".to_string(),
+            failure: None,
+        };
+        match remote.call(&Request::NewSystem {
+            set,
+            controllers: controllers.iter().map(|c| c.to_string()).collect(),
+        }) {
+            Some(Response::Done) => Ok(RemoteSystem { remote }),
+            _ => Err(remote
+                .failure
+                .unwrap_or_else(|| "unexpected answer".to_string())),
+        }
+    }
+
+    /// Give the connection back.
+    pub fn into_parts(self) -> (R, W) {
+        self.remote.into_parts()
+    }
+
+    /// Why the connection failed, if it did.
+    pub fn failure(&self) -> Option<&str> {
+        self.remote.failure()
+    }
+}
+
+impl<R: std::io::BufRead, W: std::io::Write> DrivenSystem for RemoteSystem<R, W> {
+    fn command(&mut self, root: &str, verb: &str, args: &[Value]) -> Result<u32, DriveError> {
+        self.remote.serial(&Request::SystemCommand {
+            root: root.to_string(),
+            verb: verb.to_string(),
+            args: args.to_vec(),
+        })
+    }
+
+    fn set_read(&mut self, buffer: &str, value: &Value) -> Result<(), DriveError> {
+        self.remote.unit(&Request::SystemSetRead {
+            buffer: buffer.to_string(),
+            value: value.clone(),
+        })
+    }
+
+    fn set_hook(&mut self, controller: &str, hook: &str, value: &Value) -> Result<(), DriveError> {
+        self.remote.unit(&Request::SystemSetHook {
+            controller: controller.to_string(),
+            hook: hook.to_string(),
+            value: value.clone(),
+        })
+    }
+
+    fn set_var(&mut self, controller: &str, var: &str, value: &Value) -> Result<(), DriveError> {
+        self.remote.unit(&Request::SystemSetVar {
+            controller: controller.to_string(),
+            var: var.to_string(),
+            value: value.clone(),
+        })
+    }
+
+    fn run_cpu(&mut self, cpu: &str) -> Result<Vec<(String, Record)>, DriveError> {
+        match self.remote.call(&Request::RunCpu {
+            cpu: cpu.to_string(),
+        }) {
+            Some(Response::Records(r)) => Ok(r),
+            Some(Response::Refused(e)) => Err(e),
+            _ => Ok(Vec::new()),
+        }
+    }
+}

@@ -104,6 +104,22 @@ fn a_wrong_expectation_fails_with_file_line_expected_actual_and_rows_so_far() {
     assert_eq!(stdout.lines().last(), Some("0 passed, 1 failed"));
 }
 
+#[test]
+fn a_wrong_system_expectation_names_step_controller_and_key() {
+    let out = rcsc(&[
+        "test",
+        "plans/submarine",
+        "tests/data/scenarios/wrong_system_expectation.scenario.yaml",
+    ]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains("tests/data/scenarios/wrong_system_expectation.scenario.yaml:7: scenario `wrong_system_expectation` failed here\n    step 2, TB: state: expected S1, got S0\n  rows fired so far (2 ticks):\n    SM: E0, -\n    PR: E0, E1\n    TB: E0, -\n"),
+        "{stdout}"
+    );
+    assert_eq!(stdout.lines().last(), Some("0 passed, 1 failed"));
+}
+
 const PLAN: &str = "\
 controller A {
     reads tank: Level
@@ -265,12 +281,14 @@ fn the_compiled_backend_gives_the_same_results_as_the_interpreter() {
     let wrong = [
         "plans/submarine",
         "tests/data/scenarios/wrong_expectation.scenario.yaml",
+        "tests/data/scenarios/wrong_system_expectation.scenario.yaml",
     ];
     let (code, compiled, _) = run("compiled", &wrong);
     assert_eq!(code, Some(1));
     let (_, interp, _) = run("interp", &wrong);
     assert_eq!(compiled, interp);
     assert!(compiled.contains("fired: expected E2, got none"));
+    assert!(compiled.contains("step 2, TB: state: expected S1, got S0"));
 }
 
 #[test]

@@ -228,7 +228,9 @@ fn doc_scenarios_pass(doc: &str) {
             b.lang == "yaml"
                 && b.text.contains("steps:")
                 && (b.text.contains("controller:")
-                    || b.text.lines().any(|l| l.starts_with("system:") || l.starts_with("controllers:")))
+                    || b.text
+                        .lines()
+                        .any(|l| l.starts_with("system:") || l.starts_with("controllers:")))
         })
         .collect();
     assert!(!scenarios.is_empty(), "{doc} shows a scenario");

@@ -239,7 +239,7 @@ fn drive(
                 }
             }
             for (cpu, every) in &cpus {
-                if tick % every != 0 {
+                if !tick.is_multiple_of(*every) {
                     continue;
                 }
                 for (name, rec) in d.run_cpu(cpu).map_err(fail)? {

@@ -151,3 +151,144 @@ impl<R: std::io::BufRead, W: std::io::Write> DrivenSystem for RemoteSystem<R, W>
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::handshake::Status;
+
+    /// A run of one controller `A` on CPU `main` that counts its cycles,
+    /// enough to carry every request over the protocol.
+    #[derive(Default)]
+    struct Counting {
+        cycles: u64,
+        hook: Option<Value>,
+    }
+
+    impl DrivenSystem for Counting {
+        fn command(&mut self, root: &str, _: &str, _: &[Value]) -> Result<u32, DriveError> {
+            match root {
+                "A" => Ok(7),
+                _ => Err(super::super::unknown("the run", "root controller", root)),
+            }
+        }
+        fn set_read(&mut self, _: &str, _: &Value) -> Result<(), DriveError> {
+            Ok(())
+        }
+        fn set_hook(&mut self, _: &str, _: &str, value: &Value) -> Result<(), DriveError> {
+            self.hook = Some(value.clone());
+            Ok(())
+        }
+        fn set_var(&mut self, _: &str, _: &str, _: &Value) -> Result<(), DriveError> {
+            Ok(())
+        }
+        fn run_cpu(&mut self, cpu: &str) -> Result<Vec<(String, Record)>, DriveError> {
+            if cpu != "main" {
+                return Err(super::super::unknown("the run", "CPU", cpu));
+            }
+            self.cycles += 1;
+            let status = if self.hook.is_some() {
+                Status::DONE
+            } else {
+                Status::EXECUTING
+            };
+            Ok(vec![(
+                "A".to_string(),
+                Record {
+                    cycle: self.cycles,
+                    status,
+                    ..Record::default()
+                },
+            )])
+        }
+    }
+
+    fn make(run: &[&str]) -> Result<Box<dyn DrivenSystem>, String> {
+        if run == ["A"] {
+            Ok(Box::new(Counting::default()))
+        } else {
+            Err(format!("no run {run:?}"))
+        }
+    }
+
+    #[test]
+    fn a_system_run_is_served_and_driven_remotely() {
+        // Play the client's requests into the server, then its answers back.
+        let requests = [
+            Request::NewSystem {
+                set: 0,
+                controllers: vec!["A".into()],
+            },
+            Request::SystemCommand {
+                root: "A".into(),
+                verb: "GO".into(),
+                args: vec![],
+            },
+            Request::SystemCommand {
+                root: "B".into(),
+                verb: "GO".into(),
+                args: vec![],
+            },
+            Request::SystemSetHook {
+                controller: "A".into(),
+                hook: "h".into(),
+                value: Value::Bool(true),
+            },
+            Request::RunCpu { cpu: "main".into() },
+            Request::RunCpu {
+                cpu: "other".into(),
+            },
+            Request::Cycle,
+        ];
+        let input: String = requests
+            .iter()
+            .map(|r| serde_json::to_string(r).unwrap() + "\n")
+            .collect();
+        let mut answers = Vec::new();
+        super::super::serve_systems(&[], &[make], input.as_bytes(), &mut answers).unwrap();
+        let answers: Vec<Response> = String::from_utf8(answers)
+            .unwrap()
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        assert_eq!(answers[0], Response::Done);
+        assert_eq!(answers[1], Response::Serial(7));
+        assert!(matches!(answers[2], Response::Refused(_)));
+        assert_eq!(answers[3], Response::Done);
+        let Response::Records(r) = &answers[4] else {
+            panic!("{:?}", answers[4])
+        };
+        assert_eq!((r[0].0.as_str(), r[0].1.status), ("A", Status::DONE));
+        assert!(matches!(answers[5], Response::Refused(_)));
+        // A one-controller request with no controller open fails, it does not panic.
+        assert!(matches!(answers[6], Response::Failed(_)));
+
+        // The client side reads those same answers.
+        let replies: String = answers[..5]
+            .iter()
+            .map(|a| serde_json::to_string(a).unwrap() + "\n")
+            .collect();
+        let mut sent = Vec::new();
+        let mut remote = RemoteSystem::open(replies.as_bytes(), &mut sent, 0, &["A"]).unwrap();
+        assert_eq!(remote.command("A", "GO", &[]), Ok(7));
+        assert!(remote.command("B", "GO", &[]).is_err());
+        assert_eq!(remote.set_hook("A", "h", &Value::Bool(true)), Ok(()));
+        assert_eq!(remote.run_cpu("main").unwrap().len(), 1);
+        // The connection ends: empty answers and a failure, not a panic.
+        assert_eq!(remote.run_cpu("main").unwrap(), vec![]);
+        assert!(remote.failure().is_some());
+        drop(remote);
+        let written = String::from_utf8(sent).unwrap();
+        assert!(written.starts_with("{\"NewSystem\""), "{written}");
+
+        // A run the factory refuses is a failure, reported.
+        let input = serde_json::to_string(&Request::NewSystem {
+            set: 0,
+            controllers: vec!["Z".into()],
+        })
+        .unwrap();
+        let mut out = Vec::new();
+        super::super::serve_systems(&[], &[make], input.as_bytes(), &mut out).unwrap();
+        assert!(String::from_utf8(out).unwrap().contains("no run"));
+    }
+}

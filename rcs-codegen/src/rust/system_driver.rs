@@ -184,7 +184,7 @@ pub(crate) fn system_driver(ir: &Ir, names: &Names) -> TokenStream {
 
         // Names and values a small set leaves unused (no external buffer,
         // no subordinate): one shape for every set.
-        #[allow(unused_variables, clippy::match_single_binding)]
+        #[allow(unused_variables, clippy::match_single_binding, clippy::single_match)]
         impl SystemDriver {
             /// The controllers named in `run`, fresh; a name the plan set
             /// lacks, or a run that leaves out a subordinate of one of its
@@ -237,7 +237,7 @@ pub(crate) fn system_driver(ir: &Ir, names: &Names) -> TokenStream {
             #dv::unknown("the run", "controller", "(not in the run)")
         }
 
-        #[allow(unused_variables, clippy::match_single_binding)]
+        #[allow(unused_variables, clippy::match_single_binding, clippy::single_match)]
         impl #dv::DrivenSystem for SystemDriver {
             fn command(&mut self, root: &str, verb: &str, args: &[#dv::Value]) -> Result<u32, #dv::DriveError> {
                 match root {

@@ -120,6 +120,29 @@ fn a_wrong_system_expectation_names_step_controller_and_key() {
     assert_eq!(stdout.lines().last(), Some("0 passed, 1 failed"));
 }
 
+/// Coverage counts the rows a system scenario fires in every controller
+/// of the run, not only one.
+#[test]
+fn coverage_counts_the_rows_of_every_controller_of_a_system_scenario() {
+    let out = rcsc(&[
+        "test",
+        "plans/submarine/scenarios/system_init_then_transit.scenario.yaml",
+        "--coverage",
+    ]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}");
+    let lines = coverage_lines(&stdout);
+    let fired = |plan: &str| lines.iter().find(|(n, _, _)| n == plan).map(|(_, f, _)| *f);
+    // SM, PR and TB each fired rows of their INIT and of the TRANSIT chain.
+    assert_eq!(fired("SM.INIT"), Some(2), "{stdout}");
+    assert_eq!(fired("SM.TRANSIT"), Some(2), "{stdout}");
+    assert_eq!(fired("PR.INIT"), Some(2), "{stdout}");
+    assert_eq!(fired("PR.AHEAD"), Some(3), "{stdout}");
+    assert_eq!(fired("TB.INIT"), Some(1), "{stdout}");
+    assert_eq!(fired("TB.AHEAD"), Some(2), "{stdout}");
+    assert_eq!(fired("TB.STOP"), Some(0), "{stdout}");
+}
+
 const PLAN: &str = "\
 controller A {
     reads tank: Level

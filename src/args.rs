@@ -107,6 +107,10 @@ A scenario (*.scenario.yaml) drives one controller alone: it plays the
 supervisor's commands, the subordinates' answers, the buffers the controller
 reads and the results of its hooks, and says after each step which row
 fired and what state, status, vars, writes and sent commands to expect.
+A system scenario (`system: true`, or `controllers: [A, B]` for whole
+subtrees) runs several controllers on their schedule instead, playing only
+the external buffers, the hooks and each root's supervisor, and expects
+per controller (docs/scenarios.md, \"System scenarios\").
 
 Scenarios are found under `scenarios/` beside each plan set's rcs.yaml (or
 its .rcs files), or named on the command line (a scenario named alone tests

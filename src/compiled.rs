@@ -40,6 +40,9 @@ pub struct Driver {
 /// A controller of the driver process, for one scenario.
 pub type Remote = rcs_runtime::driver::Remote<BufReader<ChildStdout>, ChildStdin>;
 
+/// A run of several controllers of the driver process, for one system scenario.
+pub type RemoteSystem = rcs_runtime::driver::RemoteSystem<BufReader<ChildStdout>, ChildStdin>;
+
 impl Driver {
     /// A fresh `controller` of plan set number `set` (in the order given to [`build`]).
     pub fn open(&mut self, set: usize, controller: &str) -> Result<Remote, String> {
@@ -52,6 +55,24 @@ impl Driver {
 
     /// Take the pipes back after a scenario.
     pub fn close(&mut self, remote: Remote) {
+        self.pipes = Some(remote.into_parts());
+    }
+
+    /// A fresh run of `controllers` of plan set number `set`, for a system scenario.
+    pub fn open_system(
+        &mut self,
+        set: usize,
+        controllers: &[&str],
+    ) -> Result<RemoteSystem, String> {
+        let (input, output) = self
+            .pipes
+            .take()
+            .ok_or("the driver connection was lost by an earlier failure")?;
+        RemoteSystem::open(input, output, set, controllers)
+    }
+
+    /// Take the pipes back after a system scenario.
+    pub fn close_system(&mut self, remote: RemoteSystem) {
         self.pipes = Some(remote.into_parts());
     }
 }
@@ -133,6 +154,7 @@ fn crate_files(irs: &[&Ir], runtime: &str) -> Vec<rcs_codegen::OutputFile> {
     }];
     let mut modules = String::new();
     let mut factories = String::new();
+    let mut system_factories = String::new();
     for (i, ir) in irs.iter().enumerate() {
         let options = rcs_codegen::Options {
             driver: true,
@@ -146,6 +168,7 @@ fn crate_files(irs: &[&Ir], runtime: &str) -> Vec<rcs_codegen::OutputFile> {
         let system = rcs_codegen::ident::ident(&rcs_codegen::ident::snake(&ir.system));
         modules.push_str(&format!("mod set_{i} {{\n    include!({file:?});\n}}\n"));
         factories.push_str(&format!("        set_{i}::{system}::new_driver,\n"));
+        system_factories.push_str(&format!("        set_{i}::{system}::new_system_driver,\n"));
         files.push(rcs_codegen::OutputFile {
             path: format!("src/{file}"),
             contents: rust.contents,
@@ -157,7 +180,8 @@ fn crate_files(irs: &[&Ir], runtime: &str) -> Vec<rcs_codegen::OutputFile> {
             "// {generated}: serves rcs_runtime::driver's protocol on stdin/stdout.\n\
              #![allow(dead_code)]\n{modules}\n\
              fn main() {{\n    let sets: &[rcs_runtime::driver::Factory] = &[\n{factories}    ];\n    \
-             let served = rcs_runtime::driver::serve(sets, std::io::stdin().lock(), std::io::stdout().lock());\n    \
+             let systems: &[rcs_runtime::driver::SystemFactory] = &[\n{system_factories}    ];\n    \
+             let served = rcs_runtime::driver::serve_systems(sets, systems, std::io::stdin().lock(), std::io::stdout().lock());\n    \
              if let Err(e) = served {{\n        eprintln!(\"scenario driver: {{e}}\");\n        std::process::exit(2);\n    }}\n}}\n"
         ),
     });
@@ -277,6 +301,7 @@ mod tests {
             .contains(rcs_codegen::GENERATED)));
         let main = &files[3].contents;
         assert!(main.contains("set_0::a::new_driver") && main.contains("set_1::a::new_driver"));
+        assert!(main.contains("set_1::a::new_system_driver") && main.contains("serve_systems"));
         assert!(files[1]
             .contents
             .contains("impl ::rcs_runtime::driver::Driven for Driver"));

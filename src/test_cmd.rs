@@ -9,7 +9,7 @@ use crate::output::*;
 use crate::{compiled, Status};
 use rcs_codegen::site::RunCounts;
 use rcs_dsl::ir::Ir;
-use rcs_dsl::scenario::{self, Outcome, Scenario};
+use rcs_dsl::scenario::{self, AnyScenario, Outcome, SystemOutcome};
 use rcs_dsl::source::SourceFile;
 use rcs_dsl::PlanSet;
 use rcs_runtime::{TraceRecord, TraceSink};
@@ -181,7 +181,8 @@ pub fn assign(sets: &[PlanSet], named: &[PathBuf]) -> Result<Vec<Vec<PathBuf>>, 
 /// One scenario to run, or a file that could not be read as one.
 pub struct Loaded {
     pub path: String,
-    pub scenario: Result<Scenario, (usize, String)>,
+    /// One controller's scenario or a system scenario.
+    pub scenario: Result<AnyScenario, (usize, String)>,
 }
 
 pub fn load(ir: &Ir, path: &Path) -> Loaded {
@@ -213,7 +214,7 @@ pub fn load(ir: &Ir, path: &Path) -> Loaded {
                 .trim_end_matches(".yml")
                 .trim_end_matches(".scenario")
                 .to_string();
-            scenario::parse(ir, &SourceFile::new(shown.clone(), text), &stem)
+            scenario::parse_any(ir, &SourceFile::new(shown.clone(), text), &stem)
                 .map_err(|e| (e.line, e.message))
         }
     };
@@ -291,7 +292,11 @@ pub fn run_set(
                 });
                 continue;
             }
-            Ok(s) => s,
+            Ok(AnyScenario::System(s)) => {
+                results.push(run_system(ir, &l.path, s, &mut remote, fired, &mut trace)?);
+                continue;
+            }
+            Ok(AnyScenario::One(s)) => s,
         };
         let name = &ir.controller(s.controller).name;
         let executive = format!("scenario {}", s.name);
@@ -339,6 +344,90 @@ pub fn run_set(
         });
     }
     Ok(results)
+}
+
+/// Run one system scenario (on the interpreter, or on the generated
+/// code's `SystemDriver` through the driver process), count its rows for
+/// every controller of the run, and write its cycles to the trace.
+fn run_system(
+    ir: &Ir,
+    path: &str,
+    s: &scenario::SystemScenario,
+    remote: &mut Option<(&mut compiled::Driver, usize)>,
+    fired: &mut Fired,
+    trace: &mut Option<&mut TraceSink>,
+) -> Result<ScenarioResult, String> {
+    let executive = format!("scenario {}", s.name);
+    let mut echoes = std::collections::BTreeMap::new();
+    let mut on_cycle = |c: rcs_dsl::ir::CtrlId, rec: &rcs_runtime::driver::Record| {
+        // A new command is one whose serial the controller now echoes.
+        let before = echoes.insert(c, rec.echo_serial);
+        if let Some(t) = trace.as_deref_mut() {
+            t.write(&TraceRecord {
+                executive: executive.as_str(),
+                cycle: rec.cycle,
+                controller: ir.controller(c).name.as_str(),
+                verb: rec.verb,
+                state: rec.verb.map(|_| rec.state),
+                status: Some(rec.status.0),
+                error: Some(rec.error.0),
+                fired: rec.fired,
+                new_command: before.is_some_and(|b| b != rec.echo_serial)
+                    || before.is_none() && rec.echo_serial != 0,
+            });
+        }
+    };
+    let outcome = match remote.as_mut() {
+        None => scenario::run_system_on(
+            ir,
+            s,
+            &mut rcs_dsl::interp::System::new(ir, &s.controllers),
+            &mut on_cycle,
+        ),
+        Some((driver, set)) => {
+            let names: Vec<&str> = s
+                .controllers
+                .iter()
+                .map(|c| ir.controller(*c).name.as_str())
+                .collect();
+            let mut r = driver.open_system(*set, &names)?;
+            let outcome = scenario::run_system_on(ir, s, &mut r, &mut on_cycle);
+            if let Some(reason) = r.failure() {
+                return Err(format!("the scenario driver failed: {reason}"));
+            }
+            driver.close_system(r);
+            outcome
+        }
+    };
+    for (c, o) in &outcome.controllers {
+        let name = &ir.controller(*c).name;
+        for ((verb, row), n) in &o.hits {
+            fired.add_row(name, verb.0, row.0, *n);
+        }
+        for ((verb, state), n) in &o.states {
+            fired.add_state(name, verb.0, state.0, *n);
+        }
+    }
+    Ok(ScenarioResult {
+        path: path.to_string(),
+        failure: system_failure_report(path, &outcome),
+    })
+}
+
+/// The report of a failed system scenario: file and line, each
+/// expectation that did not hold (step, controller, key), and the rows
+/// each controller of the run fired so far.
+fn system_failure_report(path: &str, o: &SystemOutcome) -> Option<String> {
+    let (line, report) = o.failure.as_ref()?;
+    let mut text = format!("{path}:{line}: scenario `{}` failed here\n", o.name);
+    for problem in report.lines() {
+        text.push_str(&format!("    {problem}\n"));
+    }
+    text.push_str(&format!("  rows fired so far ({} ticks):\n", o.ticks));
+    for (_, c) in &o.controllers {
+        text.push_str(&format!("    {}: {}\n", c.name, fired_so_far(&c.fired)));
+    }
+    Some(text)
 }
 
 /// Per plan of the set: rows fired out of rows, and where each unfired row is.

@@ -104,6 +104,45 @@ fn a_wrong_expectation_fails_with_file_line_expected_actual_and_rows_so_far() {
     assert_eq!(stdout.lines().last(), Some("0 passed, 1 failed"));
 }
 
+#[test]
+fn a_wrong_system_expectation_names_step_controller_and_key() {
+    let out = rcsc(&[
+        "test",
+        "plans/submarine",
+        "tests/data/scenarios/wrong_system_expectation.scenario.yaml",
+    ]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains("tests/data/scenarios/wrong_system_expectation.scenario.yaml:7: scenario `wrong_system_expectation` failed here\n    step 2, TB: state: expected S1, got S0\n  rows fired so far (2 ticks):\n    SM: E0, -\n    PR: E0, E1\n    TB: E0, -\n"),
+        "{stdout}"
+    );
+    assert_eq!(stdout.lines().last(), Some("0 passed, 1 failed"));
+}
+
+/// Coverage counts the rows a system scenario fires in every controller
+/// of the run, not only one.
+#[test]
+fn coverage_counts_the_rows_of_every_controller_of_a_system_scenario() {
+    let out = rcsc(&[
+        "test",
+        "plans/submarine/scenarios/system_init_then_transit.scenario.yaml",
+        "--coverage",
+    ]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}");
+    let lines = coverage_lines(&stdout);
+    let fired = |plan: &str| lines.iter().find(|(n, _, _)| n == plan).map(|(_, f, _)| *f);
+    // SM, PR and TB each fired rows of their INIT and of the TRANSIT chain.
+    assert_eq!(fired("SM.INIT"), Some(2), "{stdout}");
+    assert_eq!(fired("SM.TRANSIT"), Some(2), "{stdout}");
+    assert_eq!(fired("PR.INIT"), Some(2), "{stdout}");
+    assert_eq!(fired("PR.AHEAD"), Some(3), "{stdout}");
+    assert_eq!(fired("TB.INIT"), Some(1), "{stdout}");
+    assert_eq!(fired("TB.AHEAD"), Some(2), "{stdout}");
+    assert_eq!(fired("TB.STOP"), Some(0), "{stdout}");
+}
+
 const PLAN: &str = "\
 controller A {
     reads tank: Level
@@ -265,12 +304,14 @@ fn the_compiled_backend_gives_the_same_results_as_the_interpreter() {
     let wrong = [
         "plans/submarine",
         "tests/data/scenarios/wrong_expectation.scenario.yaml",
+        "tests/data/scenarios/wrong_system_expectation.scenario.yaml",
     ];
     let (code, compiled, _) = run("compiled", &wrong);
     assert_eq!(code, Some(1));
     let (_, interp, _) = run("interp", &wrong);
     assert_eq!(compiled, interp);
     assert!(compiled.contains("fired: expected E2, got none"));
+    assert!(compiled.contains("step 2, TB: state: expected S1, got S0"));
 }
 
 #[test]

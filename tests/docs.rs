@@ -12,8 +12,8 @@
 //!   `rcsc graph plans/submarine --plan PR.AHEAD --format svg` draws today
 //!   (`UPDATE_DOCS=1 cargo test --test docs` rewrites it);
 //! - the README gives the install, build and test commands, and its example
-//!   scenario passes on the submarine plans, as does the example of
-//!   `docs/scenarios.md`.
+//!   scenario passes on the submarine plans, as do the examples of
+//!   `docs/scenarios.md` (one-controller and system scenarios).
 
 use rcs_dsl::lint::Lint;
 use rcs_dsl::render::{self, Format};
@@ -218,31 +218,41 @@ fn the_scenario_reference_example_passes() {
     doc_scenarios_pass("docs/scenarios.md");
 }
 
-/// The one scenario shown in `doc` passes on the submarine plans.
+/// Every scenario shown in `doc` (one-controller and system ones) passes
+/// on the submarine plans.
 fn doc_scenarios_pass(doc: &str) {
     let text = std::fs::read_to_string(doc).unwrap();
     let scenarios: Vec<Block> = blocks(&text)
         .into_iter()
-        .filter(|b| b.lang == "yaml" && b.text.contains("controller:"))
+        .filter(|b| {
+            b.lang == "yaml"
+                && b.text.contains("steps:")
+                && (b.text.contains("controller:")
+                    || b.text
+                        .lines()
+                        .any(|l| l.starts_with("system:") || l.starts_with("controllers:")))
+        })
         .collect();
-    assert_eq!(scenarios.len(), 1, "{doc} shows one scenario");
+    assert!(!scenarios.is_empty(), "{doc} shows a scenario");
     let stem = doc.replace(['/', '.'], "-");
     let dir = std::env::temp_dir().join(format!("rcsc-docs-{stem}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("doc.scenario.yaml");
-    std::fs::write(&file, &scenarios[0].text).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_rcsc"))
-        .args(["test", "plans/submarine"])
-        .arg(&file)
-        .env("NO_COLOR", "1")
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success() && stdout.ends_with("1 passed, 0 failed\n"),
-        "{doc}:{}: the scenario fails:\n{stdout}",
-        scenarios[0].line
-    );
+    for (i, scenario) in scenarios.iter().enumerate() {
+        let file = dir.join(format!("doc{i}.scenario.yaml"));
+        std::fs::write(&file, &scenario.text).unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_rcsc"))
+            .args(["test", "plans/submarine"])
+            .arg(&file)
+            .env("NO_COLOR", "1")
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success() && stdout.ends_with("1 passed, 0 failed\n"),
+            "{doc}:{}: the scenario fails:\n{stdout}",
+            scenario.line
+        );
+    }
     std::fs::remove_dir_all(dir).ok();
 }
 

@@ -87,7 +87,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .display()
                 .to_string();
             registry.push_str(&format!(
-                "    PlanSet {{ path: {rel:?}, new_driver: {module}::{system_mod}::new_driver }},\n"
+                "    PlanSet {{ path: {rel:?}, new_driver: {module}::{system_mod}::new_driver, new_system_driver: {module}::{system_mod}::new_system_driver }},\n"
             ));
         }
     }

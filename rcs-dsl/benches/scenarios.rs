@@ -22,12 +22,17 @@ fn bench(c: &mut Criterion) {
         .map(|e| e.expect("entry").path())
         .collect();
     paths.sort();
+    // The one-controller scenarios (system scenarios are not timed here).
     let scenarios: Vec<_> = paths
         .iter()
-        .map(|p| {
+        .filter_map(|p| {
             let text = std::fs::read_to_string(p).expect("readable");
-            scenario::parse(&ir, &SourceFile::new(p.display().to_string(), text), "s")
+            match scenario::parse_any(&ir, &SourceFile::new(p.display().to_string(), text), "s")
                 .expect("valid")
+            {
+                scenario::AnyScenario::One(s) => Some(s),
+                scenario::AnyScenario::System(_) => None,
+            }
         })
         .collect();
     let cycles: usize = scenarios

@@ -20,6 +20,7 @@ use crate::arith::truthy;
 pub use crate::arith::{checked, float_to_int, round, wrap};
 pub use driven::Driven;
 pub use rcs_runtime::driver::Value;
+pub use system::System;
 pub use value::{conform, zero};
 
 /// The driver interface: [`Driven`], with scripted hooks.
@@ -29,6 +30,9 @@ mod eval;
 mod every_cycle;
 /// Jobs and the places they assign.
 mod jobs;
+/// Several controllers on their schedule, exchanging through a model of
+/// Global Memory: what system scenarios run on.
+mod system;
 /// Zero and conforming values by type.
 mod value;
 /// `X <- cmd`: the command a forward sends.
@@ -172,6 +176,15 @@ impl<'ir> Interpreter<'ir> {
         let serial = self.supervisor.next_command();
         self.command = (serial, command, params);
         serial
+    }
+
+    /// A supervisor that is itself interpreted (a system run,
+    /// [`System`]) wrote `command` with the serial and epoch its own link
+    /// drew: this controller reads that, as from Global Memory.
+    pub fn receive(&mut self, serial: u32, epoch: u32, command: CommandId, params: Vec<Value>) {
+        self.supervisor = SubordinateLink::with_epoch(epoch);
+        self.supervisor.set_last_sent(serial);
+        self.command = (serial, command, params);
     }
 
     /// The supervisor's command buffer as it stands: serial, verb, parameters.

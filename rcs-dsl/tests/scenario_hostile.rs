@@ -1,5 +1,5 @@
 //! The scenario reader and runner under hostile input: the project's
-//! scenarios with pieces of YAML spliced in anywhere are either refused
+//! scenarios (one-controller and system ones) with pieces of YAML spliced in anywhere are either refused
 //! with a line inside the file or run to an outcome — never a panic.
 //! `RCS_SCENARIO_CASES` raises the number of cases for a long run.
 
@@ -50,6 +50,17 @@ const PIECES: &[&str] = &[
     "hooks_called: { x: 1 }",
     "\u{feff}",
     "é",
+    // System scenarios' keys (the submarine's system scenario is among the files).
+    "system: true\n",
+    "controllers: [TB]\n",
+    "controllers: [PR]\n",
+    "commands: { SM: INIT }",
+    "commands: { PR: INIT }",
+    "PR: { state: S1 }",
+    "TB: { fired: E9 }",
+    "hooks: { PR: 1 }",
+    "{ PR: { required_rpm: x } }",
+    "reads: { drive: {} }",
 ];
 
 fn scenarios() -> Vec<String> {
@@ -75,34 +86,66 @@ proptest! {
         which in any::<prop::sample::Index>(),
         cuts in prop::collection::vec((any::<prop::sample::Index>(), prop::sample::select(PIECES), 0usize..4), 1..4),
     ) {
-        let set = load_folder(Path::new("../plans/submarine")).expect("plans");
-        let ir = check(&set, &Options::default()).ir.expect("clean");
         let all = scenarios();
-        let mut text = all[which.index(all.len())].clone();
-        for (at, piece, removed) in cuts {
-            let mut i = at.index(text.len() + 1);
-            while !text.is_char_boundary(i) {
-                i -= 1;
-            }
-            let mut end = (i + removed).min(text.len());
-            while !text.is_char_boundary(end) {
-                end += 1;
-            }
-            text.replace_range(i..end, piece);
+        splice_and_run(all[which.index(all.len())].clone(), cuts)?;
+    }
+
+    #[test]
+    fn spliced_system_scenarios_are_refused_with_a_line_or_run(
+        cuts in prop::collection::vec((any::<prop::sample::Index>(), prop::sample::select(PIECES), 0usize..4), 1..4),
+    ) {
+        let text = std::fs::read_to_string(
+            "../plans/submarine/scenarios/system_init_then_transit.scenario.yaml",
+        )
+        .expect("the submarine's system scenario");
+        splice_and_run(text, cuts)?;
+    }
+}
+
+/// Splice `cuts` (where, what, how many bytes it replaces) into `text`,
+/// then read it: refused with a line inside the file, or run.
+fn splice_and_run(
+    mut text: String,
+    cuts: Vec<(prop::sample::Index, &str, usize)>,
+) -> Result<(), TestCaseError> {
+    let set = load_folder(Path::new("../plans/submarine")).expect("plans");
+    let ir = check(&set, &Options::default()).ir.expect("clean");
+    for (at, piece, removed) in cuts {
+        let mut i = at.index(text.len() + 1);
+        while !text.is_char_boundary(i) {
+            i -= 1;
         }
-        // Lines as the reader counts them: a lone `\r` ends a line too.
-        let file = SourceFile::new("t.scenario.yaml", text.clone());
-        let lines = file.line_starts().len();
-        match scenario::parse(&ir, &file, "t") {
-            Err(e) => prop_assert!(e.line >= 1 && e.line <= lines + 1, "line {} of {lines}: {}\n{text}", e.line, e.message),
-            Ok(s) => {
-                // Keep the run short: a splice may ask for millions of cycles.
-                if !text.contains("cycles: 1000") && !text.contains("99999") {
-                    let _ = scenario::run(&ir, &s);
+        let mut end = (i + removed).min(text.len());
+        while !text.is_char_boundary(end) {
+            end += 1;
+        }
+        text.replace_range(i..end, piece);
+    }
+    // Lines as the reader counts them: a lone `\r` ends a line too.
+    let file = SourceFile::new("t.scenario.yaml", text.clone());
+    let lines = file.line_starts().len();
+    match scenario::parse_any(&ir, &file, "t") {
+        Err(e) => prop_assert!(
+            e.line >= 1 && e.line <= lines + 1,
+            "line {} of {lines}: {}\n{text}",
+            e.line,
+            e.message
+        ),
+        Ok(s) => {
+            // Keep the run short: a splice may ask for millions of cycles.
+            if !text.contains("cycles: 1000") && !text.contains("99999") {
+                match s {
+                    scenario::AnyScenario::One(s) => {
+                        let _ = scenario::run(&ir, &s);
+                    }
+                    scenario::AnyScenario::System(s) => {
+                        let _ = scenario::run_system(&ir, &s);
+                    }
                 }
             }
         }
     }
+    Ok(())
 }
 
 /// The case CI found: a lone `\r` splits a line (YAML and our reader agree

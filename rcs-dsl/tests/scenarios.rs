@@ -38,16 +38,24 @@ fn every_plan_scenario_passes() {
         paths.sort();
         for p in paths {
             let file = scenario_file(p.to_str().unwrap());
-            let s = scenario::parse(&ir, &file, "s")
+            let s = scenario::parse_any(&ir, &file, "s")
                 .unwrap_or_else(|e| panic!("{}:{}: {}", p.display(), e.line, e.message));
-            let out = scenario::run(&ir, &s);
-            assert!(
-                out.failure.is_none(),
-                "{}: {:?}; fired {:?}",
-                p.display(),
-                out.failure,
-                out.fired
-            );
+            match s {
+                scenario::AnyScenario::One(s) => {
+                    let out = scenario::run(&ir, &s);
+                    assert!(
+                        out.failure.is_none(),
+                        "{}: {:?}; fired {:?}",
+                        p.display(),
+                        out.failure,
+                        out.fired
+                    );
+                }
+                scenario::AnyScenario::System(s) => {
+                    let out = scenario::run_system(&ir, &s);
+                    assert!(out.failure.is_none(), "{}: {:?}", p.display(), out.failure);
+                }
+            }
             ran += 1;
         }
     }

@@ -14,7 +14,10 @@
 //! is test tooling, never the cycle path of a running system.
 
 use crate::handshake::{ErrorCode, RowId, StateId, Status, StatusBuffer, VerbId};
+
+pub mod system;
 use serde::{Deserialize, Serialize};
+pub use system::{DrivenSystem, RemoteSystem, SystemFactory};
 
 /// A value of any plan type, as the interpreter computes it and as the
 /// generated types convert to and from it ([`ToValue`], [`FromValue`]).
@@ -457,6 +460,53 @@ pub enum Request {
         /// The value it publishes.
         value: Value,
     },
+    /// Replace what is driven by a fresh run of the named controllers of
+    /// plan set number `set` (its [`SystemFactory`]).
+    NewSystem {
+        /// The plan set.
+        set: usize,
+        /// The controllers of the run (whole subtrees).
+        controllers: Vec<String>,
+    },
+    /// [`DrivenSystem::command`].
+    SystemCommand {
+        /// The root of the run commanded.
+        root: String,
+        /// The verb.
+        verb: String,
+        /// Its arguments.
+        args: Vec<Value>,
+    },
+    /// [`DrivenSystem::set_read`].
+    SystemSetRead {
+        /// The external buffer.
+        buffer: String,
+        /// Its value.
+        value: Value,
+    },
+    /// [`DrivenSystem::set_hook`].
+    SystemSetHook {
+        /// The controller.
+        controller: String,
+        /// Its hook.
+        hook: String,
+        /// What it returns.
+        value: Value,
+    },
+    /// [`DrivenSystem::set_var`].
+    SystemSetVar {
+        /// The controller.
+        controller: String,
+        /// Its var.
+        var: String,
+        /// Its value.
+        value: Value,
+    },
+    /// [`DrivenSystem::run_cpu`].
+    RunCpu {
+        /// The CPU's name in the schedule.
+        cpu: String,
+    },
 }
 
 /// The answer to one [`Request`].
@@ -468,6 +518,8 @@ pub enum Response {
     Serial(u32),
     /// What the cycle did.
     Record(Record),
+    /// What one CPU's cycle did, per controller (`RunCpu`).
+    Records(Vec<(String, Record)>),
     /// The driven controller refused a name or value.
     Refused(DriveError),
     /// The request could not be served at all (no such plan set or
@@ -485,13 +537,46 @@ pub type Factory = fn(&str) -> Option<Result<Box<dyn Driven>, crate::SetupError>
 pub fn serve(
     sets: &[Factory],
     input: impl std::io::BufRead,
+    output: impl std::io::Write,
+) -> std::io::Result<()> {
+    serve_systems(sets, &[], input, output)
+}
+
+/// [`serve`], with system runs too: `systems[i]` makes the runs of plan
+/// set `i` (`NewSystem` and the `System…`/`RunCpu` requests).
+pub fn serve_systems(
+    sets: &[Factory],
+    systems: &[SystemFactory],
+    input: impl std::io::BufRead,
     mut output: impl std::io::Write,
 ) -> std::io::Result<()> {
     let mut driven: Option<Box<dyn Driven>> = None;
+    let mut run: Option<Box<dyn DrivenSystem>> = None;
     for line in input.lines() {
         let line = line?;
         let response = match serde_json::from_str::<Request>(&line) {
             Err(e) => Response::Failed(format!("malformed request: {e}")),
+            Ok(Request::NewSystem { set, controllers }) => {
+                let names: Vec<&str> = controllers.iter().map(String::as_str).collect();
+                match systems.get(set).map(|make| make(&names)) {
+                    None => Response::Failed(format!("no system runs for plan set number {set}")),
+                    Some(Err(e)) => Response::Failed(format!("setting up the run: {e}")),
+                    Some(Ok(d)) => {
+                        run = Some(d);
+                        Response::Done
+                    }
+                }
+            }
+            Ok(
+                request @ (Request::SystemCommand { .. }
+                | Request::SystemSetRead { .. }
+                | Request::SystemSetHook { .. }
+                | Request::SystemSetVar { .. }
+                | Request::RunCpu { .. }),
+            ) => match run.as_deref_mut() {
+                None => Response::Failed("no system run yet: send `NewSystem` first".to_string()),
+                Some(d) => system::answer(d, request),
+            },
             Ok(Request::New { set, controller }) => {
                 match sets.get(set).map(|make| make(&controller)) {
                     None => Response::Failed(format!("no plan set number {set}")),
@@ -533,6 +618,7 @@ fn answer(d: &mut dyn Driven, request: Request) -> Response {
         Request::WriteSubField { sub, field, value } => {
             done(d.write_sub_field(&sub, &field, &value))
         }
+        _ => Response::Failed("a system request to one controller".to_string()),
     }
 }
 

@@ -12,6 +12,9 @@ pub struct PlanSet {
     /// A fresh generated controller of the set, by name, behind
     /// `rcs_runtime::driver::Driven` (`None`: no such controller).
     pub new_driver: rcs_runtime::driver::Factory,
+    /// A fresh generated run of the named controllers of the set (whole
+    /// subtrees) behind `rcs_runtime::driver::DrivenSystem`.
+    pub new_system_driver: rcs_runtime::driver::SystemFactory,
 }
 
 pub mod c_port;

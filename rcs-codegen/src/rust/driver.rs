@@ -266,8 +266,20 @@ pub(crate) fn driver_parts(ir: &Ir, names: &Names, ci: usize, part: DriverPart) 
     let bind_data = if c.vars.is_empty() && c.writes.is_empty() {
         quote!()
     } else {
-        quote!(let data = self.controller.data();)
+        quote!(let data = c.data();)
     };
+    let (hook_c, var_c) = (
+        if c.hooks.is_empty() {
+            quote!(_)
+        } else {
+            quote!(c)
+        },
+        if c.vars.is_empty() {
+            quote!(_)
+        } else {
+            quote!(c)
+        },
+    );
     let before = if c.subordinates.is_empty() {
         quote!()
     } else {
@@ -315,7 +327,7 @@ pub(crate) fn driver_parts(ir: &Ir, names: &Names, ci: usize, part: DriverPart) 
         (
             quote!(value),
             quote!(#(#hook_names => {
-                self.controller.hooks_mut().#hook_fields = #dv::typed(NAME, hook, value)?;
+                c.hooks_mut().#hook_fields = #dv::typed(NAME, hook, value)?;
                 Ok(())
             })*),
         )
@@ -327,7 +339,7 @@ pub(crate) fn driver_parts(ir: &Ir, names: &Names, ci: usize, part: DriverPart) 
         (
             quote!(value),
             quote!(#(#var_names => {
-                self.controller.data.vars.#var_fields = #dv::typed(NAME, var, value)?;
+                c.data.vars.#var_fields = #dv::typed(NAME, var, value)?;
                 Ok(())
             })*),
         )
@@ -405,12 +417,12 @@ pub(crate) fn driver_parts(ir: &Ir, names: &Names, ci: usize, part: DriverPart) 
                 #read_match_body
             }
 
-            fn set_hook(&mut self, hook: &str, #hook_param: &#dv::Value) -> Result<(), #dv::DriveError> {
-                #hook_match_body
+            fn set_hook(&mut self, hook: &str, value: &#dv::Value) -> Result<(), #dv::DriveError> {
+                driven_set_hook(&mut self.controller, hook, value)
             }
 
-            fn set_var(&mut self, var: &str, #var_param: &#dv::Value) -> Result<(), #dv::DriveError> {
-                #var_match_body
+            fn set_var(&mut self, var: &str, value: &#dv::Value) -> Result<(), #dv::DriveError> {
+                driven_set_var(&mut self.controller, var, value)
             }
 
             fn set_write(&mut self, buffer: &str, #write_param: &#dv::Value) -> Result<(), #dv::DriveError> {
@@ -436,26 +448,44 @@ pub(crate) fn driver_parts(ir: &Ir, names: &Names, ci: usize, part: DriverPart) 
                 };
                 rt::Controller::cycle(&mut self.controller, &ctx);
                 self.cycle += 1;
-                let hook_calls = self.controller.hooks().call_counts.to_vec();
-                self.controller.hooks_mut().call_counts = [0; #hook_count];
-                let hook_args = ::std::mem::take(&mut self.controller.hooks_mut().call_args);
-                let bk = self.controller.bookkeeping();
-                #bind_data
-                #dv::Record {
-                    cycle: ctx.cycle,
-                    verb: (bk.echo_serial() != 0).then_some(bk.verb()),
-                    fired: bk.fired(),
-                    state: bk.state(),
-                    status: bk.status(),
-                    error: bk.error(),
-                    echo_serial: bk.echo_serial(),
-                    refused_serial: bk.refused_serial(),
-                    sent: #sent_body,
-                    vars: vec![#(#dv::ToValue::to_value(&data.vars.#var_fields)),*],
-                    writes: vec![#(#dv::ToValue::to_value(&data.writes.#write_fields)),*],
-                    hook_calls,
-                    hook_args,
-                }
+                let sent = #sent_body;
+                driven_record(&mut self.controller, ctx.cycle, sent)
+            }
+        }
+
+        /// Hook `hook` of `c` returns `value` from now on (`Driven::set_hook`;
+        /// also what the `SystemDriver` of the plan set calls).
+        pub fn driven_set_hook(#hook_c: &mut Controller<ScriptedHooks>, hook: &str, #hook_param: &#dv::Value) -> Result<(), #dv::DriveError> {
+            #hook_match_body
+        }
+
+        /// Var `var` of `c` holds `value` (`Driven::set_var`).
+        pub fn driven_set_var(#var_c: &mut Controller<ScriptedHooks>, var: &str, #var_param: &#dv::Value) -> Result<(), #dv::DriveError> {
+            #var_match_body
+        }
+
+        /// The record of the cycle `c` just ran (its `cycle` number and the
+        /// commands it `sent`), taking the hook calls it counted.
+        pub fn driven_record(c: &mut Controller<ScriptedHooks>, cycle: u64, sent: Vec<#dv::Sent>) -> #dv::Record {
+            let hook_calls = c.hooks().call_counts.to_vec();
+            c.hooks_mut().call_counts = [0; #hook_count];
+            let hook_args = ::std::mem::take(&mut c.hooks_mut().call_args);
+            let bk = c.bookkeeping();
+            #bind_data
+            #dv::Record {
+                cycle,
+                verb: (bk.echo_serial() != 0).then_some(bk.verb()),
+                fired: bk.fired(),
+                state: bk.state(),
+                status: bk.status(),
+                error: bk.error(),
+                echo_serial: bk.echo_serial(),
+                refused_serial: bk.refused_serial(),
+                sent,
+                vars: vec![#(#dv::ToValue::to_value(&data.vars.#var_fields)),*],
+                writes: vec![#(#dv::ToValue::to_value(&data.writes.#write_fields)),*],
+                hook_calls,
+                hook_args,
             }
         }
     }

@@ -54,6 +54,12 @@ impl<'ir> Driven<'ir> {
         &self.interp
     }
 
+    /// The interpreter underneath, to feed it what a system run's Global
+    /// Memory holds ([`super::System`]).
+    pub(super) fn interpreter_mut(&mut self) -> &mut Interpreter<'ir> {
+        &mut self.interp
+    }
+
     fn sub_index(&self, sub: &str) -> Result<usize, rcs_runtime::driver::DriveError> {
         let c = self.interp.controller();
         self.ir

@@ -12,10 +12,15 @@
 mod read;
 mod report;
 mod run;
+mod script;
+mod system;
+mod system_read;
 mod values;
 
-pub use read::parse;
+pub use read::{parse, parse_any, AnyScenario};
 pub use run::{run, run_observed, run_on};
+pub use script::{run_script, ControllerExpect, SystemScript, SystemStep};
+pub use system::{run_system, run_system_on, schedule, state_name, SystemOutcome, SystemScenario};
 
 use crate::interp::Value;
 use crate::ir::{CommandId, CtrlId, HookId, RowId, StateId};

@@ -49,7 +49,7 @@ struct RawStep {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawExpect {
+pub(super) struct RawExpect {
     fired: Option<Spanned<Json>>,
     state: Option<Spanned<String>>,
     status: Option<Spanned<String>>,
@@ -67,12 +67,12 @@ struct RawExpect {
 /// file order, each entry with the line of its key, so that a name the
 /// plans lack is reported on its own line.
 #[derive(Default)]
-struct Entries(Vec<Entry>);
+pub(super) struct Entries(pub(super) Vec<Entry>);
 
-struct Entry {
-    line: usize,
-    name: String,
-    value: Json,
+pub(super) struct Entry {
+    pub(super) line: usize,
+    pub(super) name: String,
+    pub(super) value: Json,
 }
 
 impl<'de> Deserialize<'de> for Entries {
@@ -110,20 +110,53 @@ impl<'de> Deserialize<'de> for Entries {
 }
 
 /// The line a scenario value was written on.
-fn line_of<T>(s: &Spanned<T>) -> usize {
+pub(super) fn line_of<T>(s: &Spanned<T>) -> usize {
     s.referenced.line() as usize
 }
 
 /// The entries of an optional mapping: (line of the key, name, value).
-fn entries(e: &Option<Entries>) -> impl Iterator<Item = (usize, &str, &Json)> {
+pub(super) fn entries(e: &Option<Entries>) -> impl Iterator<Item = (usize, &str, &Json)> {
     e.as_ref()
         .map_or(&[][..], |e| &e.0)
         .iter()
         .map(|e| (e.line, e.name.as_str(), &e.value))
 }
 
-/// Read and resolve a scenario. `stem` names it when it has no `name:`.
+/// A scenario of either kind: one controller, or a run of several
+/// (`system: true`, `controllers: [...]`).
+pub enum AnyScenario {
+    One(Scenario),
+    System(super::SystemScenario),
+}
+
+impl AnyScenario {
+    pub fn name(&self) -> &str {
+        match self {
+            AnyScenario::One(s) => &s.name,
+            AnyScenario::System(s) => &s.name,
+        }
+    }
+}
+
+/// Read and resolve a scenario of either kind: a file with `system:` or
+/// `controllers:` at the top is a system scenario.
+pub fn parse_any(ir: &Ir, file: &SourceFile, stem: &str) -> Result<AnyScenario, ScenarioError> {
+    if super::system_read::is_system(&file.text) {
+        super::system_read::parse_system(ir, &file.text, stem).map(AnyScenario::System)
+    } else {
+        parse(ir, file, stem).map(AnyScenario::One)
+    }
+}
+
+/// Read and resolve a one-controller scenario. `stem` names it when it has
+/// no `name:`. A system scenario is refused: read it with [`parse_any`].
 pub fn parse(ir: &Ir, file: &SourceFile, stem: &str) -> Result<Scenario, ScenarioError> {
+    if super::system_read::is_system(&file.text) {
+        return Err(err(
+            1,
+            "a system scenario (`system:` or `controllers:`), not one of one controller",
+        ));
+    }
     let raw: RawScenario = yaml::from_str_names(&file.text)
         .map_err(|e| err(e.location.map_or(1, |l| l.line() as usize), e.message))?;
     let cline = line_of(&raw.controller);
@@ -177,9 +210,9 @@ pub fn parse(ir: &Ir, file: &SourceFile, stem: &str) -> Result<Scenario, Scenari
     })
 }
 
-struct Resolver<'a> {
-    ir: &'a Ir,
-    c: &'a Controller,
+pub(super) struct Resolver<'a> {
+    pub(super) ir: &'a Ir,
+    pub(super) c: &'a Controller,
 }
 
 impl Resolver<'_> {
@@ -284,7 +317,7 @@ impl Resolver<'_> {
     }
 
     /// `cycles: N`, 1 to [`MAX_CYCLES`].
-    fn cycles(&self, c: &Spanned<Json>) -> Result<u64, ScenarioError> {
+    pub(super) fn cycles(&self, c: &Spanned<Json>) -> Result<u64, ScenarioError> {
         let n = match &c.value {
             Json::Number(n) => n.as_u64(),
             _ => None,
@@ -301,7 +334,7 @@ impl Resolver<'_> {
     }
 
     /// `vars:` (in `initial:` and `expect:`): each a whole value.
-    fn vars(&self, e: &Option<Entries>) -> Result<Vec<(usize, Value)>, ScenarioError> {
+    pub(super) fn vars(&self, e: &Option<Entries>) -> Result<Vec<(usize, Value)>, ScenarioError> {
         let mut out = Vec::new();
         for (line, name, v) in entries(e) {
             let i = self
@@ -540,7 +573,7 @@ impl Resolver<'_> {
         }
     }
 
-    fn expect(&self, e: RawExpect) -> Result<Expect, ScenarioError> {
+    pub(super) fn expect(&self, e: RawExpect) -> Result<Expect, ScenarioError> {
         let mut out = Expect::default();
         if let Some(f) = e.fired {
             let line = line_of(&f);

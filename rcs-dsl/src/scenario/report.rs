@@ -48,6 +48,19 @@ pub(super) fn check(
     latest: u32,
     hooks: StepCalls,
 ) -> Option<String> {
+    let problems = problems(ir, c, e, rec, latest, hooks);
+    (!problems.is_empty()).then(|| problems.join("; "))
+}
+
+/// [`check`]'s findings, one per expectation that does not hold.
+pub(super) fn problems(
+    ir: &Ir,
+    c: &Controller,
+    e: &Expect,
+    rec: &Record,
+    latest: u32,
+    hooks: StepCalls,
+) -> Vec<String> {
     let mut problems = Vec::new();
     // What the supervisor sees for its latest command (the handshake view):
     // a refused command is answered ERROR/REFUSED whatever the plan that
@@ -161,7 +174,7 @@ pub(super) fn check(
     for (h, want) in &e.hooks_called {
         check_called(ir, c, *h, want, hooks, &mut problems);
     }
-    (!problems.is_empty()).then(|| problems.join("; "))
+    problems
 }
 
 /// The calls of all a step's cycles: a count per hook, and the arguments

@@ -241,7 +241,7 @@ fn drive(
 
 /// Add a cycle's row to the outcome: its name to the run-length list,
 /// (verb, row) to the coverage set.
-fn note_fired(c: &Controller, rec: &Record, out: &mut Outcome) {
+pub(super) fn note_fired(c: &Controller, rec: &Record, out: &mut Outcome) {
     let name = match rec.fired {
         None => "-".to_string(),
         Some(r) => match plan_of(c, rec) {

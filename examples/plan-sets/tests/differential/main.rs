@@ -113,6 +113,7 @@ const OK_0107: &str = "tests/data/ok/0107_analysis_hooks_and_arguments.rcs";
 
 mod inputs;
 mod running;
+mod systems;
 
 use running::*;
 

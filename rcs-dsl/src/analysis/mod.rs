@@ -49,7 +49,9 @@ pub mod command;
 pub mod cycles;
 pub mod domain;
 pub mod eval;
+mod handshake;
 pub mod index_range;
+mod names;
 pub mod path;
 pub mod run;
 pub mod search;
@@ -57,9 +59,7 @@ pub mod terms;
 pub mod value;
 mod walk;
 
-use crate::ir::{
-    Condition, Controller, CtrlId, Expr, ExprKind, From, Ir, Plan, StateId, StatusId, Target, Type,
-};
+use crate::ir::{Condition, Controller, CtrlId, Expr, ExprKind, From, Ir, Plan, StateId, Type};
 use rcs_runtime::driver::Value;
 use search::{Mode, Outcome, Search};
 use std::sync::Arc;
@@ -257,133 +257,6 @@ impl<'ir> PlanAnalysis<'ir> {
     pub fn can_fire_while(&self, row: usize, other: usize, state: StateId) -> Answer {
         let (f, fixed, state) = self.question(Question::FiresWhile(row, other, state));
         self.decide(&f, &fixed, state)
-    }
-
-    /// Whether, in `state`, no row can match while subordinate `sub` shows
-    /// `status`, whatever every other input is: the plan then stays in
-    /// `state` until a new command. `Some` carries one such cycle's inputs;
-    /// `None` when some row may match (or the analysis cannot tell, or no
-    /// condition reads `sub`'s status).
-    ///
-    /// With `alive`, `sub` keeps writing its status buffer every cycle of
-    /// this controller (it runs at least as often), so `sub.stale_cycles`
-    /// is 0 on every cycle: a watchdog on it cannot fire.
-    pub fn stalls_in(
-        &self,
-        state: StateId,
-        sub: CtrlId,
-        status: StatusId,
-        alive: bool,
-    ) -> Option<Witness> {
-        if !self.analysed_over_cycles() {
-            return None;
-        }
-        let leaf = self.terms.find(&Leaf::SubStatus(sub))?;
-        let any = self.conditions_covering(state)?;
-        let mut fixed = self.fixed(state);
-        fixed.push((leaf, Value::Status(status.0 as u16)));
-        if let Some(stale) = alive
-            .then(|| self.terms.find(&Leaf::SubStale(sub)))
-            .flatten()
-        {
-            fixed.push((stale, Value::Int(0)));
-        }
-        let some_row = Formula::Or(any);
-        if !matches!(self.prove(&some_row, &fixed), Outcome::None) {
-            return None;
-        }
-        let none = Formula::Not(Box::new(some_row));
-        let candidates = self.candidates();
-        match Search::new(&self.terms, Mode::Witness, candidates, &[], &fixed)
-            .in_order(self.indexed)
-            .run(&none)
-        {
-            Outcome::Found(values) => Some(self.witness(&none, state, values)),
-            Outcome::None | Outcome::Unknown => None,
-        }
-    }
-
-    /// Whether the verb's `accept when` condition can be false on a
-    /// command's arrival: `Some` carries such a cycle's inputs, in `S0`.
-    /// `None` when the verb has none, it always holds, or the analysis
-    /// cannot tell.
-    pub fn refusal(&self) -> Option<Witness> {
-        let accept = self.accept.as_ref()?;
-        let refused = Formula::Not(Box::new(accept.clone()));
-        let fixed = [(self.new_command, Value::Bool(true))];
-        match self.decide(&refused, &fixed, StateId::S0) {
-            Answer::Can(w) => Some(w),
-            Answer::Never | Answer::Unknown => None,
-        }
-    }
-
-    /// [`never_fires_in`](Self::never_fires_in) with some leaves pinned
-    /// (the command's parameters): a proof, `false` when unknown.
-    pub fn never_fires_in_given(
-        &self,
-        row: usize,
-        state: StateId,
-        given: &[(LeafId, Value)],
-    ) -> bool {
-        if self.skipped {
-            return false;
-        }
-        let Some(f) = self.fires(row, state) else {
-            return true;
-        };
-        let mut fixed = self.fixed(state);
-        fixed.extend(given.iter().cloned());
-        matches!(self.prove(&f, &fixed), Outcome::None)
-    }
-
-    /// Whether the verb's `accept when` is false on a command's arrival
-    /// whatever the inputs not `given` (the command's parameters) are: a
-    /// proof that such a command is refused; `false` when unknown.
-    pub fn always_refused(&self, given: &[(LeafId, Value)]) -> bool {
-        let Some(accept) = &self.accept else {
-            return false;
-        };
-        let mut fixed = vec![(self.new_command, Value::Bool(true))];
-        fixed.extend(given.iter().cloned());
-        matches!(self.prove(accept, &fixed), Outcome::None)
-    }
-
-    /// Whether a command of this plan's verb is answered `ERROR` on its
-    /// arrival cycle whatever the inputs, with the `given` leaves (its
-    /// parameters) pinned: refused by `accept when`, or accepted and then
-    /// the first row to match always ends in `Error`. A proof: `None` when
-    /// it is not so or the analysis cannot tell. `Some(rows)` lists the
-    /// rows that can answer (empty for a refusal).
-    pub fn always_rejects(&self, given: &[(LeafId, Value)]) -> Option<Vec<usize>> {
-        if self.skipped || self.indexed {
-            return None;
-        }
-        if self.always_refused(given) {
-            return Some(Vec::new());
-        }
-        let mut fixed = vec![(self.new_command, Value::Bool(true))];
-        fixed.extend(given.iter().cloned());
-        let accepted = self.accept.clone().unwrap_or(Formula::Const(true));
-        let mut failing = Vec::new();
-        for (i, row) in self.plan.rows.iter().enumerate() {
-            let Some(fires) = self.fires(i, StateId::S0) else {
-                continue;
-            };
-            let can = !matches!(self.prove(&fires, &fixed), Outcome::None);
-            match row.to {
-                Target::Error(_) | Target::ErrorOf(_) if can => failing.push(i),
-                Target::Error(_) | Target::ErrorOf(_) => {}
-                _ if can => return None,
-                _ => {}
-            }
-        }
-        // Accepted, some row must fire: else the plan waits in S0.
-        let any = self.conditions_covering(StateId::S0)?;
-        let idle = Formula::And(vec![accepted, Formula::Not(Box::new(Formula::Or(any)))]);
-        if !matches!(self.prove(&idle, &fixed), Outcome::None) || failing.is_empty() {
-            return None;
-        }
-        Some(failing)
     }
 
     /// [`can_match`](Self::can_match) is [`Answer::Never`], without looking
@@ -674,104 +547,6 @@ impl<'ir> PlanAnalysis<'ir> {
             state,
             inputs,
             shown,
-        }
-    }
-
-    /// A leaf as the language writes it.
-    pub fn leaf_name(&self, leaf: &Leaf) -> String {
-        use crate::ir::{Expr, ExprKind, SubProp};
-        let printer = crate::pretty::Printer::new(self.ir, self.ctrl, Some(self.plan));
-        let sub = |c: crate::ir::CtrlId| self.ir.controller(c).name.clone();
-        match leaf {
-            Leaf::NewCommand => "new_command".into(),
-            Leaf::StateCycles => "state_cycles".into(),
-            Leaf::PlanCycles => "plan_cycles".into(),
-            Leaf::SubStatus(c) => format!("{}.status", sub(*c)),
-            Leaf::SubStale(c) => format!("{}.{}", sub(*c), SubProp::StaleCycles.name()),
-            Leaf::SubErrorCode(c) => format!("{}.{}", sub(*c), SubProp::ErrorCode.name()),
-            Leaf::BufStale(b) => format!("{}.stale_cycles", self.ir.buffers[b.index()].name),
-            Leaf::Call(h, args) => printer.expr(&Expr {
-                kind: ExprKind::Call(*h, args.clone()),
-                ty: self.ctrl.hooks[h.index()].ret.clone(),
-                span: self.plan.span,
-            }),
-            Leaf::Param(p, steps) => {
-                let param = &self.ctrl.commands[self.plan.verb.index()].params[p.index()];
-                self.path(format!("cmd.{}", param.name), &param.ty, steps)
-            }
-            Leaf::Var(v, steps) => {
-                let var = &self.ctrl.vars[v.index()];
-                self.path(var.name.clone(), &var.ty, steps)
-            }
-            Leaf::SubField(c, v, steps) => {
-                let var = &self.ir.controller(*c).vars[v.index()];
-                self.path(format!("{}.{}", sub(*c), var.name), &var.ty, steps)
-            }
-            Leaf::Buffer(b, steps) => {
-                let buf = &self.ir.buffers[b.index()];
-                let fields = &self.ir.buffer_types[buf.ty.index()].fields;
-                // The first step is a field of the buffer's type.
-                match steps.split_first() {
-                    Some((terms::Step::Field(f), rest)) => {
-                        let field = &fields[*f as usize];
-                        self.path(format!("{}.{}", buf.name, field.name), &field.ty, rest)
-                    }
-                    _ => buf.name.clone(),
-                }
-            }
-        }
-    }
-
-    fn path(&self, mut name: String, mut ty: &'ir Type, steps: &[terms::Step]) -> String {
-        for s in steps {
-            match (s, ty) {
-                (terms::Step::Field(f), Type::Buffer(b)) => {
-                    let field = &self.ir.buffer_types[b.index()].fields[*f as usize];
-                    name.push('.');
-                    name.push_str(&field.name);
-                    ty = &field.ty;
-                }
-                (terms::Step::Index(i), Type::Array(e, _)) => {
-                    name.push_str(&format!("[{i}]"));
-                    ty = e;
-                }
-                _ => {}
-            }
-        }
-        name
-    }
-
-    /// A value as the language writes it.
-    pub fn value_text(&self, ty: &Type, v: &Value) -> String {
-        match (ty, v) {
-            (Type::ErrorCode(c), Value::Int(n)) => crate::error_codes::name_of(
-                self.ir.controller(*c),
-                rcs_runtime::ErrorCode(u16::try_from(*n).unwrap_or(u16::MAX)),
-            ),
-            (_, Value::Bool(b)) => b.to_string(),
-            (_, Value::Int(i)) => i.to_string(),
-            (_, Value::Float(f)) if f.is_nan() => "NaN".into(),
-            (_, Value::Float(f)) if f.is_infinite() => if *f > 0.0 { "inf" } else { "-inf" }.into(),
-            (_, Value::Float(f)) => crate::pretty::float(*f),
-            (Type::Array(e, _), Value::Array(xs)) => {
-                let xs: Vec<String> = xs.iter().map(|x| self.value_text(e, x)).collect();
-                format!("[{}]", xs.join(", "))
-            }
-            (Type::Enum(e), Value::Enum(i)) => {
-                let def = &self.ir.enums[e.index()];
-                let variant = def
-                    .variants
-                    .get(*i as usize)
-                    .map_or("?", |v| v.name.as_str());
-                format!("{}::{variant}", def.name)
-            }
-            (Type::Status(c), Value::Status(s)) => self
-                .ir
-                .controller(*c)
-                .statuses
-                .get(*s as usize)
-                .map_or_else(|| format!("?{s}"), |d| d.name.clone()),
-            (_, v) => format!("{v:?}"),
         }
     }
 }

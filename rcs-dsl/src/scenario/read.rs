@@ -282,20 +282,7 @@ impl Resolver<'_> {
     /// with the line of the key.
     fn silent(&self, v: &Spanned<Json>) -> Result<(usize, Vec<usize>), ScenarioError> {
         let line = line_of(v);
-        let shape = || {
-            err(
-                line,
-                "`silent` is a list of `reads` buffers held unwritten: `silent: [io]`",
-            )
-        };
-        let names: Vec<&str> = match &v.value {
-            Json::Array(xs) => xs
-                .iter()
-                .map(|x| x.as_str().ok_or_else(shape))
-                .collect::<Result<_, _>>()?,
-            Json::String(s) => vec![s.as_str()],
-            _ => return Err(shape()),
-        };
+        let names = silent_names(v, "`reads` buffers")?;
         let mut out = Vec::new();
         for name in names {
             let i = self
@@ -692,4 +679,23 @@ fn error_names(c: &Controller) -> String {
         .chain(c.errors.iter().map(|e| e.name.as_str()))
         .collect();
     format!("its codes are {}", names.join(", "))
+}
+
+/// The names of a `silent:` list (or one name alone), each a string; else
+/// an error at the key's line saying it holds a list of `what`.
+pub(super) fn silent_names<'a>(
+    v: &'a Spanned<Json>,
+    what: &str,
+) -> Result<Vec<&'a str>, ScenarioError> {
+    let shape = || {
+        err(
+            line_of(v),
+            format!("`silent` is a list of {what} held unwritten: `silent: [io]`"),
+        )
+    };
+    match &v.value {
+        Json::Array(xs) => xs.iter().map(|x| x.as_str().ok_or_else(shape)).collect(),
+        Json::String(s) => Ok(vec![s.as_str()]),
+        _ => Err(shape()),
+    }
 }

@@ -354,20 +354,7 @@ impl SystemResolver<'_> {
 
     fn silent(&self, v: &Spanned<Json>) -> Result<Vec<BufferId>, ScenarioError> {
         let line = line_of(v);
-        let shape = || {
-            err(
-                line,
-                "`silent` is a list of external buffers held unwritten: `silent: [io]`",
-            )
-        };
-        let names: Vec<&str> = match &v.value {
-            Json::Array(xs) => xs
-                .iter()
-                .map(|x| x.as_str().ok_or_else(shape))
-                .collect::<Result<_, _>>()?,
-            Json::String(s) => vec![s.as_str()],
-            _ => return Err(shape()),
-        };
+        let names = super::read::silent_names(v, "external buffers")?;
         names.into_iter().map(|n| self.external(line, n)).collect()
     }
 

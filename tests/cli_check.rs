@@ -231,16 +231,7 @@ fn witnesses_are_scenarios_that_rcsc_test_passes() {
         let again = scratch(&format!("witnesses{i}again"), &[]);
         rcsc(&["check", case, "--witnesses", again.to_str().unwrap()]);
         assert_eq!(common::tree(&dir), common::tree(&again), "{case}");
-        let mut args = vec!["test", case];
-        args.extend(files.iter().map(String::as_str));
-        let out = rcsc(&args);
-        assert_eq!(
-            out.status.code(),
-            Some(0),
-            "{case}: {}{}",
-            text(&out.stdout),
-            text(&out.stderr)
-        );
+        assert_replays(case, &files);
         written += files.len();
     }
     assert!(written >= 6, "only {written} witnesses");
@@ -310,14 +301,7 @@ fn value_lint_witnesses_replay_in_rcsc_test() {
         assert!(name.starts_with(&format!("{lint}_")), "{case}: {name}");
         let body = std::fs::read_to_string(&files[0]).unwrap();
         with_vars += usize::from(body.contains("    vars:"));
-        let out = rcsc(&["test", case, &files[0]]);
-        assert_eq!(
-            out.status.code(),
-            Some(0),
-            "{case}: {}{}",
-            text(&out.stdout),
-            text(&out.stderr)
-        );
+        assert_replays(case, &files);
     }
     assert!(with_vars >= 5, "only {with_vars} runs expect the value");
 }
@@ -351,18 +335,24 @@ fn cross_controller_witnesses_replay_in_rcsc_test() {
             continue;
         }
         with_error += usize::from(out.status.code() != Some(0));
-        let mut args = vec!["test", case.as_str()];
-        args.extend(files.iter().map(String::as_str));
-        let out = rcsc(&args);
-        assert_eq!(
-            out.status.code(),
-            Some(0),
-            "{case}: {}{}",
-            text(&out.stdout),
-            text(&out.stderr)
-        );
+        assert_replays(case, &files);
         replayed += files.len();
     }
     assert!(replayed >= 12, "only {replayed} runs replayed");
     assert!(with_error >= 1, "no case with an error of the checks");
+}
+
+/// `rcsc test CASE FILES…` passes: the witness scenarios written for a
+/// case replay on its plans.
+fn assert_replays(case: &str, files: &[String]) {
+    let mut args = vec!["test", case];
+    args.extend(files.iter().map(String::as_str));
+    let out = rcsc(&args);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{case}: {}{}",
+        text(&out.stdout),
+        text(&out.stderr)
+    );
 }

@@ -39,6 +39,24 @@ impl Witnesses {
             if let Ok(text) = scenario_text(run, &stem, &about) {
                 self.files.insert(format!("{stem}.scenario.yaml"), text);
             }
+            // A handshake finding, reproduced with the subordinate running
+            // its own plan: the same finding as a system scenario.
+            let ir = checked.ir.as_ref().or(checked.rejected_by_checks.as_ref());
+            if let (Some(script), Some(ir)) = (&w.system, ir) {
+                let stem = self.free_stem(&format!("{stem}_system"));
+                let script = rcs_dsl::scenario::SystemScript {
+                    name: stem.clone(),
+                    ..script.clone()
+                };
+                let mut text = String::new();
+                for line in about.lines() {
+                    text.push_str("# ");
+                    text.push_str(line);
+                    text.push('\n');
+                }
+                text.push_str(&script.to_yaml(ir));
+                self.files.insert(format!("{stem}.scenario.yaml"), text);
+            }
         }
     }
 

@@ -7,6 +7,12 @@
 
 use std::path::{Path, PathBuf};
 
+#[path = "../../rcs-dsl/tests/common/hierarchy.rs"]
+mod hierarchy;
+
+/// How many random hierarchies are compiled for the differential test.
+const HIERARCHIES: usize = 8;
+
 fn module_name(path: &Path) -> String {
     let stem = path
         .file_stem()
@@ -95,6 +101,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "/// Every plan set above: its path from the workspace root and its\n\
          /// generated scenario driver.\npub const SETS: &[PlanSet] = &[\n{registry}];\n"
     ));
+    let hierarchies = random_hierarchies(&out, &mut includes)?;
+    includes.push_str(&format!(
+        "/// Random hierarchies whose checks found a cross-controller finding\n\
+         /// with a system run (`rcs-dsl/tests/common/hierarchy.rs`; `path`\n\
+         /// is absolute, under `OUT_DIR`).\npub const RANDOM_HIERARCHIES: &[PlanSet] = &[\n{hierarchies}];\n"
+    ));
     std::fs::write(out.join("sets.rs"), includes)?;
 
     // The folders themselves: a plan set added to either is compiled in
@@ -102,10 +114,67 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("cargo::rerun-if-changed=../../plans");
     println!("cargo::rerun-if-changed=../../tests/data/ok");
     println!("cargo::rerun-if-changed=c/pr_template.c");
+    println!("cargo::rerun-if-changed=../../rcs-dsl/tests/common/hierarchy.rs");
     cc::Build::new()
         .file("c/pr_template.c")
         .opt_level(2)
         .warnings(true)
         .compile("pr_template");
     Ok(())
+}
+
+/// The first [`HIERARCHIES`] random hierarchies, on fixed seeds, that check
+/// without an error and have a cross-controller finding with a system run
+/// (the property the differential test then checks on generated code),
+/// compiled as the sets above are; their registry entries.
+fn random_hierarchies(
+    out: &Path,
+    includes: &mut String,
+) -> Result<String, Box<dyn std::error::Error>> {
+    let mut registry = String::new();
+    let mut kept = 0;
+    for n in 0..2000u64 {
+        if kept == HIERARCHIES {
+            break;
+        }
+        let seed = n.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        let h = hierarchy::random_hierarchy(seed);
+        let dir = out.join("hierarchies").join(format!("h{n}"));
+        std::fs::create_dir_all(&dir)?;
+        std::fs::write(dir.join("plans.rcs"), &h.plans)?;
+        std::fs::write(dir.join("rcs.yaml"), &h.manifest)?;
+        let Ok(set) = rcs_dsl::load_folder(&dir) else {
+            continue;
+        };
+        let checked = rcs_dsl::check(&set, &rcs_dsl::Options::default());
+        let witnessed = checked
+            .diagnostics
+            .iter()
+            .any(|d| d.witness.as_ref().is_some_and(|w| w.system.is_some()));
+        if checked.ir.is_none() || !witnessed {
+            std::fs::remove_dir_all(&dir)?;
+            continue;
+        }
+        let module = format!("hierarchy_{n}");
+        let dest = out.join("hierarchy_sets").join(&module);
+        // Their findings are the point: not printed as build warnings.
+        rcs_codegen::Config::new()
+            .out_dir(&dest)
+            .graphs(false)
+            .driver(true)
+            .compile_with_io(&dir, &mut std::io::sink(), &mut std::io::sink())?;
+        let system = format!("h{n}");
+        let rust = dest.join("rust").join(format!("{system}.rs"));
+        let system_mod = rcs_codegen::ident::ident(&rcs_codegen::ident::snake(&system));
+        includes.push_str(&format!(
+            "pub mod {module} {{\n    include!({:?});\n}}\n",
+            rust.display().to_string()
+        ));
+        registry.push_str(&format!(
+            "    PlanSet {{ path: {:?}, new_driver: {module}::{system_mod}::new_driver, new_system_driver: {module}::{system_mod}::new_system_driver }},\n",
+            dir.display().to_string()
+        ));
+        kept += 1;
+    }
+    Ok(registry)
 }

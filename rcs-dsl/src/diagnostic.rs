@@ -301,6 +301,30 @@ pub struct Witness {
     /// writes as a scenario).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub run: Option<crate::analysis::run::Run>,
+    /// For a finding between a supervisor and a subordinate: what a run of
+    /// the supervisor's whole subtree needs of the subordinate. Set by the
+    /// check, read once to compose `system`.
+    #[serde(skip)]
+    pub across: Option<Across>,
+    /// The same finding reproduced with the supervisor's whole subtree
+    /// running, the subordinate playing its own plan: a system scenario,
+    /// replayed on the interpreter before it is kept (what `rcsc check
+    /// --witnesses` writes for such a finding).
+    #[serde(skip)]
+    pub system: Option<crate::scenario::SystemScript>,
+}
+
+/// What a cross-controller finding's system run needs of the subordinate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Across {
+    pub sub: crate::ir::CtrlId,
+    /// The status it must show at the end of the run, by name (`ERROR`,
+    /// `DONE`, a declared status); `None`: not compared.
+    pub shows: Option<String>,
+    /// A run of the supervisor, before the finding's own, that commands
+    /// the subordinate: it answers that command as the finding's run then
+    /// reads (`stale_subordinate_status`: an earlier command's answer).
+    pub earlier: Option<crate::analysis::run::Run>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -388,7 +412,18 @@ impl Diagnostic {
                 })
                 .collect(),
             run: None,
+            across: None,
+            system: None,
         });
+        self
+    }
+
+    /// What a run of the whole subtree needs of the subordinate (after
+    /// [`Diagnostic::with_run`]).
+    pub fn with_across(mut self, across: Across) -> Self {
+        if let Some(w) = &mut self.witness {
+            w.across = Some(across);
+        }
         self
     }
 
@@ -471,6 +506,23 @@ impl Diagnostics {
 
     pub fn iter(&self) -> impl Iterator<Item = &Diagnostic> {
         self.list.iter()
+    }
+
+    /// Of the diagnostics from position `start` on, keep those `keep` says
+    /// (one flag each, in order; missing flags keep).
+    pub fn keep_from(&mut self, start: usize, keep: &[bool]) {
+        let mut i = 0;
+        self.list.retain(|_| {
+            let kept = i < start || keep.get(i - start).copied().unwrap_or(true);
+            i += 1;
+            kept
+        });
+    }
+
+    /// The diagnostics from position `start` on, to amend.
+    pub fn since_mut(&mut self, start: usize) -> &mut [Diagnostic] {
+        let start = start.min(self.list.len());
+        &mut self.list[start..]
     }
 
     pub fn is_empty(&self) -> bool {

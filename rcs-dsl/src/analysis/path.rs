@@ -101,8 +101,21 @@ impl PlanAnalysis<'_> {
     /// the row stays or ends the plan), after a wait for a counter if it
     /// needs one; replayed. `None` when no such run is found.
     pub fn fire_from(&self, prefix: &Run, r: usize, at: StateId, to: StateId) -> Option<Run> {
+        self.fire_from_given(prefix, r, at, to, &[])
+    }
+
+    /// [`fire_from`](Self::fire_from) with some leaves pinned (the
+    /// command's parameters at the values a supervisor sends).
+    pub fn fire_from_given(
+        &self,
+        prefix: &Run,
+        r: usize,
+        at: StateId,
+        to: StateId,
+        given: &[(LeafId, Value)],
+    ) -> Option<Run> {
         let scene = self.scene(prefix)?;
-        self.fire_after(prefix, &scene, r, at, to, &[])
+        self.fire_after(prefix, &scene, r, at, to, given)
     }
 
     /// `prefix`, then row `r` firing from `at` into `to` on the very next

@@ -153,9 +153,14 @@ pub fn run(ir: &Ir, levels: &LintLevels, sources: &SourceMap, diags: &mut Diagno
         handshake::check_status_never_reported(ir, *ci, &summaries, &mut sink);
         diags
     });
+    let handshake_start = sink.diags.len();
     for d in found {
         sink.diags.extend(d);
     }
+    // The handshake findings' runs, again with the subordinates running
+    // their own plans: whole-subtree system runs, replayed.
+    let keep = handshake::add_system_runs(ir, sink.diags.since_mut(handshake_start));
+    sink.diags.keep_from(handshake_start, &keep);
     hierarchy::check_span_of_control(ir, &mut sink);
     hierarchy::check_level_order(ir, &mut sink);
     diags.sort_from(start, sources);

@@ -73,6 +73,19 @@ pub fn run_script(ir: &Ir, script: &SystemScript) -> Result<SystemOutcome, Scena
     Ok(run_system(ir, &s))
 }
 
+/// [`run_script`], showing each controller cycle's record to `on_cycle`
+/// (how a witness learns when a command reached a subordinate).
+pub(crate) fn run_script_observed(
+    ir: &Ir,
+    script: &SystemScript,
+    on_cycle: &mut dyn FnMut(CtrlId, &rcs_runtime::driver::Record),
+) -> Result<SystemOutcome, ScenarioError> {
+    let text = script.to_yaml(ir);
+    let s = super::system_read::parse_system(ir, &text, &script.name)?;
+    let mut system = crate::interp::System::new(ir, &s.controllers);
+    Ok(super::system::run_system_on(ir, &s, &mut system, on_cycle))
+}
+
 impl SystemScript {
     /// The scenario file (`*.scenario.yaml`): [`from_yaml`](Self::from_yaml)
     /// reads it back to this script. Names not in `ir` are written as

@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 const SHOWN_ELEMENTS: usize = 8;
 
 /// A YAML value as a run-time value of type `t` (what is not given is zero).
-pub(super) fn value(
+pub(crate) fn value(
     ir: &Ir,
     line: usize,
     t: &Type,
@@ -92,7 +92,7 @@ pub(super) fn value(
 /// Merge a YAML value into `base`: a buffer's fields not named keep
 /// theirs, as do an array's elements not indexed by a `{ N: value }`
 /// mapping; a list is the array's first elements, the rest zero.
-pub(super) fn merge(
+pub(crate) fn merge(
     ir: &Ir,
     line: usize,
     base: &Value,

@@ -111,6 +111,7 @@ const OK_0017: &str = "tests/data/ok/0017_lint_levels";
 const OK_0018: &str = "tests/data/ok/0018_allowed_lints_and_bare_initialisers.rcs";
 const OK_0107: &str = "tests/data/ok/0107_analysis_hooks_and_arguments.rcs";
 
+mod hierarchies;
 mod inputs;
 mod running;
 mod systems;

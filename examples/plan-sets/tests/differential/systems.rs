@@ -51,47 +51,59 @@ fn run_all() -> Result<(usize, usize), String> {
                 Ok(AnyScenario::One(_)) => continue,
                 Err(e) => return Err(format!("{}:{}: {}", p.display(), e.line, e.message)),
             };
-            let names: Vec<&str> = s
-                .controllers
-                .iter()
-                .map(|c| ir.controller(*c).name.as_str())
-                .collect();
-            let mut interp_trace = Vec::new();
-            let a = scenario::run_system_on(
-                ir,
-                &s,
-                &mut rcs_dsl::interp::System::new(ir, &s.controllers),
-                &mut |c, r| interp_trace.push(shown(&ir.controller(c).name, r)),
-            );
-            let mut compiled =
-                (set.new_system_driver)(&names).map_err(|e| format!("{}: {e}", p.display()))?;
-            let mut compiled_trace = Vec::new();
-            let b = scenario::run_system_on(ir, &s, compiled.as_mut(), &mut |c, r| {
-                compiled_trace.push(shown(&ir.controller(c).name, r))
-            });
-            if let Some(i) = (0..interp_trace.len().max(compiled_trace.len()))
-                .find(|i| interp_trace.get(*i) != compiled_trace.get(*i))
-            {
-                return Err(format!(
-                    "{}: the interpreter and the generated code diverge at controller cycle {i}:\n  interp:   {:?}\n  compiled: {:?}",
-                    p.display(),
-                    interp_trace.get(i),
-                    compiled_trace.get(i)
-                ));
-            }
-            for (backend, o) in [("interpreter", &a), ("generated code", &b)] {
-                if let Some((line, report)) = &o.failure {
-                    return Err(format!(
-                        "{}:{line}: fails on the {backend}:\n{report}",
-                        p.display()
-                    ));
-                }
-            }
+            cycles += both_backends(ir, set, &s, &p.display().to_string())?;
             scenarios += 1;
-            cycles += interp_trace.len();
         }
     }
     Ok((scenarios, cycles))
+}
+
+/// Run system scenario `s` of `set` on the interpreter and on the
+/// generated code: both must pass and give the same record for every
+/// controller cycle, in the same order. Returns the cycles compared;
+/// `what` names the scenario in a failure.
+pub(crate) fn both_backends(
+    ir: &rcs_dsl::ir::Ir,
+    set: &rcs_plan_sets::PlanSet,
+    s: &scenario::SystemScenario,
+    what: &str,
+) -> Result<usize, String> {
+    let names: Vec<&str> = s
+        .controllers
+        .iter()
+        .map(|c| ir.controller(*c).name.as_str())
+        .collect();
+    let mut interp_trace = Vec::new();
+    let a = scenario::run_system_on(
+        ir,
+        s,
+        &mut rcs_dsl::interp::System::new(ir, &s.controllers),
+        &mut |c, r| interp_trace.push(shown(&ir.controller(c).name, r)),
+    );
+    let mut compiled = (set.new_system_driver)(&names).map_err(|e| format!("{}: {e}", what))?;
+    let mut compiled_trace = Vec::new();
+    let b = scenario::run_system_on(ir, s, compiled.as_mut(), &mut |c, r| {
+        compiled_trace.push(shown(&ir.controller(c).name, r))
+    });
+    if let Some(i) = (0..interp_trace.len().max(compiled_trace.len()))
+        .find(|i| interp_trace.get(*i) != compiled_trace.get(*i))
+    {
+        return Err(format!(
+            "{}: the interpreter and the generated code diverge at controller cycle {i}:\n  interp:   {:?}\n  compiled: {:?}",
+            what,
+            interp_trace.get(i),
+            compiled_trace.get(i)
+        ));
+    }
+    for (backend, o) in [("interpreter", &a), ("generated code", &b)] {
+        if let Some((line, report)) = &o.failure {
+            return Err(format!(
+                "{}:{line}: fails on the {backend}:\n{report}",
+                what
+            ));
+        }
+    }
+    Ok(interp_trace.len())
 }
 
 #[test]
@@ -119,7 +131,10 @@ fn draw<S: proptest::strategy::Strategy>(runner: &mut TestRunner, s: S) -> S::Va
 /// random values of their types, 1–5 ticks a step and now and then
 /// 50–300 (so that timeouts fire). Every call must answer alike and every
 /// CPU cycle give the same records. Returns the controller cycles compared.
-fn random_runs(set: &rcs_plan_sets::PlanSet, ir: &rcs_dsl::ir::Ir) -> Result<u64, String> {
+pub(crate) fn random_runs(
+    set: &rcs_plan_sets::PlanSet,
+    ir: &rcs_dsl::ir::Ir,
+) -> Result<u64, String> {
     use rcs_dsl::ir::{CtrlId, Type};
     use rcs_runtime::driver::DrivenSystem;
     let run: Vec<CtrlId> = (0..ir.controllers.len())

@@ -20,12 +20,14 @@ mod overwritten;
 mod rejected;
 mod reported;
 mod stale;
+mod system_run;
 mod unhandled;
 
 pub(crate) use overwritten::check_command_overwritten;
 pub(crate) use rejected::check_always_rejected;
 pub(crate) use reported::check_status_never_reported;
 pub(crate) use stale::check_stale_subordinate_status;
+pub(crate) use system_run::add_system_runs;
 pub(crate) use unhandled::check_unhandled_error;
 
 use super::graph::Analysis;
@@ -94,8 +96,13 @@ pub(crate) enum Failure {
 /// analyses and its subordinates' summaries, and no controller's analyses
 /// have to outlive its own checks.
 pub(crate) struct Summary {
-    /// Per plan: the first way it can answer `ERROR`.
+    /// Per plan: the first way it may answer `ERROR`, by the analysis of
+    /// one cycle (a row that can match in a reachable state; a run to it
+    /// is searched only when a finding needs it, [`proved_failure`]).
     failures: Vec<Option<Failure>>,
+    /// Per plan: where an index can fall outside its array (a way to fail
+    /// the `index_range` check proves with its own replayed run).
+    out_of_range: Vec<Option<Span>>,
     /// Per command: the `accept when` span, where the condition can be
     /// false on a command's arrival (the command is then `REFUSED`).
     refusals: Vec<Option<Span>>,
@@ -200,6 +207,7 @@ impl Summary {
             .collect();
         Summary {
             failures,
+            out_of_range: out_of_range.iter().map(|o| o.first().copied()).collect(),
             refusals,
             reported,
             overwritten,
@@ -222,6 +230,83 @@ pub(crate) fn failure(ir: &Ir, summaries: &[Summary], x: CtrlId, verb: CommandId
             failure: f,
         })
         .or(s.refusals[verb.index()].map(|span| Why::Refused { verb, span }))
+}
+
+/// How subordinate `x` answers `ERROR` to a verb `rows` send it, proved:
+/// a row of its plan that fails (ends in `Error`, reports `ERROR`),
+/// reached by a run replayed on the interpreter with the command's
+/// parameters at the constant arguments sent (free where an argument is
+/// not a constant); else a built-in `INDEX_RANGE`, which the
+/// `index_range` check proves with its own run; else a refusal, whose
+/// inputs a command's arrival can have. `None` when none is proved: a row
+/// that matches in a reachable state may still never fire (an earlier
+/// row always ends the plan first), and then nothing is said.
+pub(crate) fn proved_failure(
+    ir: &Ir,
+    summaries: &[Summary],
+    rows: &[Row],
+    x: CtrlId,
+) -> Option<Why> {
+    let xc = ir.controller(x);
+    let s = &summaries[x.index()];
+    let verbs = verbs_sent(rows, x);
+    for &verb in &verbs {
+        let Some(pid) = xc.commands[verb.index()].plan else {
+            continue;
+        };
+        if s.failures[pid.index()].is_none() {
+            continue;
+        }
+        for args in args_sent(rows, x, verb) {
+            if let Some((row, _)) = system_run::failure_run(ir, x, verb, &args) {
+                let r = &xc.plans[pid.index()].rows[row];
+                let failure = if matches!(r.to, Target::Error(_) | Target::ErrorOf(_)) {
+                    Failure::Ends { row }
+                } else {
+                    Failure::Reports { row }
+                };
+                return Some(Why::Plan {
+                    plan: pid.index(),
+                    failure,
+                });
+            }
+        }
+    }
+    verbs
+        .iter()
+        .find_map(|&verb| {
+            let pid = xc.commands[verb.index()].plan?.index();
+            s.out_of_range[pid].map(|span| Why::Plan {
+                plan: pid,
+                failure: Failure::IndexRange { span },
+            })
+        })
+        .or_else(|| {
+            verbs
+                .iter()
+                .find_map(|&verb| s.refusals[verb.index()].map(|span| Why::Refused { verb, span }))
+        })
+}
+
+/// The argument lists `rows` send `x` with `verb`: the constant ones, and
+/// an empty list (parameters free) for a send whose arguments are not all
+/// constants.
+fn args_sent(rows: &[Row], x: CtrlId, verb: CommandId) -> Vec<Vec<Value>> {
+    let mut out: Vec<Vec<Value>> = Vec::new();
+    for j in rows.iter().flat_map(|r| &r.jobs) {
+        let to_x = j.sends_to().is_some_and(|(sub, _)| sub == x);
+        if !(to_x && j.commands_sent().contains(&verb)) {
+            continue;
+        }
+        let args = match rejected::constant_send(j, x) {
+            Some((_, args)) => args,
+            None => Vec::new(),
+        };
+        if !out.contains(&args) {
+            out.push(args);
+        }
+    }
+    out
 }
 
 /// A subordinate's way to answer `ERROR`, located for a label.
@@ -323,7 +408,7 @@ pub(crate) fn sends(r: &Row, x: CtrlId) -> bool {
 
 /// The reports of a row a supervisor can see: the last one, unless the
 /// row ends the plan (the final status replaces it in the same cycle).
-fn visible_reports(r: &Row) -> Vec<(StatusId, Span)> {
+pub(crate) fn visible_reports(r: &Row) -> Vec<(StatusId, Span)> {
     if !matches!(r.to, Target::State(_) | Target::Same) {
         return Vec::new();
     }

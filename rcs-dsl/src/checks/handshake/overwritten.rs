@@ -15,7 +15,7 @@
 use super::super::Sink;
 use super::{reads_answer_of, sends, status_tests, Supervisor};
 use crate::analysis::covers;
-use crate::diagnostic::Diagnostic;
+use crate::diagnostic::{Across, Diagnostic};
 use crate::ir::{CtrlId, Ir, Job, StateId, StatusId, Target};
 use crate::lint::Lint;
 
@@ -97,6 +97,11 @@ pub(crate) fn check_command_overwritten(sup: &Supervisor, sink: &mut Sink) {
                     .with_secondary(r1.span, format!("`{sub}` is sent `{first_name}` here"))
                     .with_witness(state, &w.shown)
                     .with_run(Some(run))
+                    .with_across(Across {
+                        sub: x,
+                        shows: None,
+                        earlier: None,
+                    })
                     .with_note(format!(
                         "no row of `{state}` waits for `{sub}`'s answer, and `{sub}`'s plan for \
                          `{first_name}` cannot answer on its first cycle: `{sub}` is still \

@@ -14,7 +14,7 @@ use super::{Summary, Supervisor};
 use crate::analysis::eval::eval;
 use crate::analysis::terms::Leaf;
 use crate::analysis::{covers, Answer, PlanAnalysis};
-use crate::diagnostic::Diagnostic;
+use crate::diagnostic::{Across, Diagnostic};
 use crate::ir::{CommandId, Controller, Expr, Ir, Job, ParamId, StateId, Target};
 use crate::lint::Lint;
 use crate::source::Span;
@@ -199,6 +199,11 @@ pub(crate) fn check_always_rejected(sup: &Supervisor, sink: &mut Sink) {
                 .with_secondary(rej.because, label)
                 .with_witness(&p.states[w.state.index()].name, &w.shown)
                 .with_run(Some(run))
+                .with_across(Across {
+                    sub: *sub,
+                    shows: Some("ERROR".into()),
+                    earlier: None,
+                })
                 .with_note(note)
                 .with_help(format!(
                     "send `{x}` arguments its plan for `{verb_name}` takes, or drop the send"

@@ -16,7 +16,7 @@ use super::{failure, sends, status_tests, verbs_sent, verbs_sent_by, Summary, Su
 use crate::analysis::run::{row_name, Expect, Run};
 use crate::analysis::terms::Leaf;
 use crate::analysis::{covers, Answer, PlanAnalysis};
-use crate::diagnostic::Diagnostic;
+use crate::diagnostic::{Across, Diagnostic};
 use crate::ir::{CtrlId, Ir, Plan, StateId, StatusId, Target};
 use crate::lint::Lint;
 use rcs_runtime::driver::Value;
@@ -95,6 +95,11 @@ pub(crate) fn check_stale_subordinate_status(sup: &Supervisor, sink: &mut Sink) 
                         )
                         .with_witness(state_name, &w.shown)
                         .with_run(Some(run))
+                        .with_across(Across {
+                            sub: x,
+                            shows: None,
+                            earlier: commanding_run(sup, p, x),
+                        })
                         .with_note(format!(
                             "{when} this plan has not yet commanded `{sub}`, so `{}` sees \
                              `{sub}`'s answer to the last command it sent before — another \
@@ -183,4 +188,37 @@ fn way_to(
         })
     });
     clean.then(|| path.clone())
+}
+
+/// A run of one of the supervisor's plans (`first` before the others)
+/// that commands `x`: the way to a row that sends `x` a command, and that
+/// row firing; replayed. What the system run of a finding plays first, so
+/// that `x` has an earlier command to answer.
+fn commanding_run(sup: &Supervisor, first: &Plan, x: CtrlId) -> Option<Run> {
+    let mut plans: Vec<(&Plan, &PlanAnalysis)> =
+        sup.plans(true).map(|(p, an, _)| (p, an)).collect();
+    plans.sort_by_key(|(p, _)| !std::ptr::eq(*p, first));
+    plans.into_iter().find_map(|(p, an)| {
+        let rows: Vec<usize> = (0..p.rows.len())
+            .filter(|i| sends(&p.rows[*i], x))
+            .collect();
+        if rows.is_empty() {
+            return None;
+        }
+        let paths = an.paths();
+        rows.into_iter().find_map(|i| {
+            let r = &p.rows[i];
+            paths.iter().enumerate().find_map(|(s, prefix)| {
+                let at = StateId(s as u32);
+                if !covers(&r.from, at) {
+                    return None;
+                }
+                let to = match r.to {
+                    Target::State(t) => t,
+                    _ => at,
+                };
+                an.fire_from(prefix.as_ref()?, i, at, to)
+            })
+        })
+    })
 }

@@ -11,9 +11,9 @@
 //! path, then 30 cycles with X in `ERROR` and no row firing.
 
 use super::super::Sink;
-use super::{failure, status_tests, verbs_sent, writes_every_cycle_of, Supervisor};
+use super::{failure, proved_failure, status_tests, verbs_sent, writes_every_cycle_of, Supervisor};
 use crate::analysis::covers;
-use crate::diagnostic::Diagnostic;
+use crate::diagnostic::{Across, Diagnostic};
 use crate::ir::{CtrlId, Row, StateId, StatusId, SubProp};
 use crate::lint::Lint;
 
@@ -31,11 +31,13 @@ pub(crate) fn check_unhandled_error(sup: &Supervisor, sink: &mut Sink) {
         // Paths to each state, searched once a finding needs one.
         let paths = std::cell::OnceCell::new();
         for &x in &c.subordinates {
-            // The verbs this plan sends X, and a way X can fail at one.
+            // A way X may fail at a verb this plan sends it, by the
+            // analysis of one cycle; proved by a run once a finding needs it.
             let sent = verbs_sent(&p.rows, x);
-            let Some(why) = sent.iter().find_map(|v| failure(ir, summaries, x, *v)) else {
+            if !sent.iter().any(|v| failure(ir, summaries, x, *v).is_some()) {
                 continue;
-            };
+            }
+            let proved = std::cell::OnceCell::new();
             let alive = writes_every_cycle_of(ir, ci, x);
             for s in (0..p.states.len()).filter(|s| graph.reachable[*s]) {
                 let state = StateId(s as u32);
@@ -50,6 +52,10 @@ pub(crate) fn check_unhandled_error(sup: &Supervisor, sink: &mut Sink) {
                     continue;
                 };
                 let Some(w) = conditions.stalls_in(state, x, StatusId::ERROR, alive) else {
+                    continue;
+                };
+                let Some(why) = *proved.get_or_init(|| proved_failure(ir, summaries, &p.rows, x))
+                else {
                     continue;
                 };
                 let paths = paths.get_or_init(|| conditions.paths());
@@ -76,7 +82,12 @@ pub(crate) fn check_unhandled_error(sup: &Supervisor, sink: &mut Sink) {
                 )
                 .with_secondary(x_span, x_label)
                 .with_witness(state_name, &w.shown)
-                .with_run(run);
+                .with_run(run)
+                .with_across(Across {
+                    sub: x,
+                    shows: Some("ERROR".into()),
+                    earlier: None,
+                });
                 d = if watchdog {
                     d.with_note(format!(
                         "with `{sub}.status == ERROR` no row of `{state_name}` matches: a failed \

@@ -25,19 +25,7 @@ impl Resolver<'_> {
         let command = command
             .map(|c| self.command(line_of(&c), &c.value))
             .transpose()?;
-        let mut read_list = Vec::new();
-        for (line, name, v) in entries(&reads) {
-            let i = self
-                .c
-                .reads
-                .iter()
-                .position(|b| self.ir.buffers[b.index()].name == *name)
-                .ok_or_else(|| err(line, format!("`{}` reads no buffer `{name}`", self.c.name)))?;
-            // Check the shape now; values merge into the current buffer when run.
-            let ty = Type::Buffer(self.ir.buffers[self.c.reads[i].index()].ty);
-            merge(self.ir, line, &zero(self.ir, &ty), &ty, v, name)?;
-            read_list.push((i, v.clone()));
-        }
+        let read_list = self.buffer_entries(&reads, &self.c.reads, "reads")?;
         let mut hook_list = Vec::new();
         for (line, name, v) in entries(&hooks) {
             let h = self
@@ -136,15 +124,25 @@ impl Resolver<'_> {
     /// `writes:` (in `initial:` and `expect:`): fields of the controller's
     /// own buffers, checked now and merged when used.
     pub(super) fn writes(&self, e: &Option<Entries>) -> Result<Vec<(usize, Json)>, ScenarioError> {
+        self.buffer_entries(e, &self.c.writes, "writes")
+    }
+
+    /// The entries of a `reads:` or `writes:` mapping: each buffer's index
+    /// in `buffers` (the controller's list `what` names) and its value.
+    fn buffer_entries(
+        &self,
+        e: &Option<Entries>,
+        buffers: &[BufferId],
+        what: &str,
+    ) -> Result<Vec<(usize, Json)>, ScenarioError> {
         let mut out = Vec::new();
         for (line, name, v) in entries(e) {
-            let i = self
-                .c
-                .writes
+            let i = buffers
                 .iter()
                 .position(|b| self.ir.buffers[b.index()].name == *name)
-                .ok_or_else(|| err(line, format!("`{}` writes no buffer `{name}`", self.c.name)))?;
-            let ty = Type::Buffer(self.ir.buffers[self.c.writes[i].index()].ty);
+                .ok_or_else(|| err(line, format!("`{}` {what} no buffer `{name}`", self.c.name)))?;
+            // Check the shape now; values merge into the current buffer when run.
+            let ty = Type::Buffer(self.ir.buffers[buffers[i].index()].ty);
             merge(self.ir, line, &zero(self.ir, &ty), &ty, v, name)?;
             out.push((i, v.clone()));
         }

@@ -117,6 +117,16 @@ fn every_example_in_the_language_reference_checks_as_it_says() {
                 }
                 checked += 1;
             }
+            "yaml" if b.text.contains("steps:") => {
+                // A scenario of the `rcs` block before it: `rcsc test` passes it.
+                let rcs = previous_rcs.as_deref().unwrap_or_else(|| {
+                    panic!("docs/language.md:{}: no rcs block before it", b.line)
+                });
+                if let Err(report) = scenario_passes(rcs, &b.text, b.line) {
+                    failures.push(format!("docs/language.md:{}: {report}", b.line));
+                }
+                checked += 1;
+            }
             "yaml" => match b.expected() {
                 Some(want) => {
                     let rcs = previous_rcs.as_deref().unwrap_or_else(|| {
@@ -216,6 +226,33 @@ fn the_readme_scenario_passes() {
 #[test]
 fn the_scenario_reference_example_passes() {
     doc_scenarios_pass("docs/scenarios.md");
+}
+
+/// Whether `rcsc test` passes `scenario` on the plan set made of `rcs`.
+fn scenario_passes(rcs: &str, scenario: &str, line: usize) -> Result<(), String> {
+    let dir =
+        std::env::temp_dir().join(format!("rcsc-docs-scenario-{line}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    std::fs::write(dir.join("example.rcs"), rcs).map_err(|e| e.to_string())?;
+    let file = dir.join("example.scenario.yaml");
+    std::fs::write(&file, scenario).map_err(|e| e.to_string())?;
+    let out = Command::new(env!("CARGO_BIN_EXE_rcsc"))
+        .arg("test")
+        .arg(&dir)
+        .arg(&file)
+        .env("NO_COLOR", "1")
+        .output()
+        .map_err(|e| e.to_string())?;
+    std::fs::remove_dir_all(&dir).ok();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    if out.status.success() && stdout.ends_with("1 passed, 0 failed\n") {
+        Ok(())
+    } else {
+        Err(format!(
+            "the scenario fails:\n{stdout}{}",
+            String::from_utf8_lossy(&out.stderr)
+        ))
+    }
 }
 
 /// Every scenario shown in `doc` (one-controller and system ones) passes

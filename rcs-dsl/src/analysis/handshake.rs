@@ -56,6 +56,59 @@ impl PlanAnalysis<'_> {
         }
     }
 
+    /// A weaker stall than [`stalls_in`](Self::stalls_in): inputs the
+    /// outside world can hold (buffers read, hook results, the other
+    /// subordinates' statuses and fields) at values with which no row of
+    /// `state` matches while `sub` shows `status`, whatever the counters
+    /// (`state_cycles`, `plan_cycles`, every `stale_cycles`) and vars
+    /// become — so while those inputs hold, the plan stays for ever: the
+    /// rows that could leave wait on something else that may never come.
+    /// A proof for the held values; the witness holds them.
+    pub fn stalls_while(
+        &self,
+        state: StateId,
+        sub: CtrlId,
+        status: StatusId,
+        alive: bool,
+    ) -> Option<Witness> {
+        if !self.analysed_over_cycles() {
+            return None;
+        }
+        let leaf = self.terms.find(&Leaf::SubStatus(sub))?;
+        let any = self.conditions_covering(state)?;
+        let mut fixed = self.fixed(state);
+        fixed.push((leaf, Value::Status(status.0 as u16)));
+        if let Some(stale) = alive
+            .then(|| self.terms.find(&Leaf::SubStale(sub)))
+            .flatten()
+        {
+            fixed.push((stale, Value::Int(0)));
+        }
+        let some_row = Formula::Or(any);
+        let none = Formula::Not(Box::new(some_row.clone()));
+        let values = match Search::new(&self.terms, Mode::Witness, self.candidates(), &[], &fixed)
+            .in_order(self.indexed)
+            .run(&none)
+        {
+            Outcome::Found(values) => values,
+            Outcome::None | Outcome::Unknown => return None,
+        };
+        let w = self.witness(&none, state, values);
+        let mut held = fixed.clone();
+        for (l, v) in &w.inputs {
+            let holds = matches!(
+                l,
+                Leaf::Buffer(..) | Leaf::Call(..) | Leaf::SubStatus(_) | Leaf::SubField(..)
+            );
+            if let (true, Some(id)) = (holds, self.terms.find(l)) {
+                if !held.iter().any(|(h, _)| *h == id) {
+                    held.push((id, v.clone()));
+                }
+            }
+        }
+        matches!(self.prove(&some_row, &held), Outcome::None).then_some(w)
+    }
+
     /// Whether the verb's `accept when` condition can be false on a
     /// command's arrival: `Some` carries such a cycle's inputs, in `S0`.
     /// `None` when the verb has none, it always holds, or the analysis

@@ -51,8 +51,18 @@ pub(crate) fn check_unhandled_error(sup: &Supervisor, sink: &mut Sink) {
                 let Some(&(first, awaited)) = waiting.first() else {
                     continue;
                 };
-                let Some(w) = conditions.stalls_in(state, x, StatusId::ERROR, alive) else {
-                    continue;
+                // No row can match whatever the other inputs; or, weaker, no
+                // row can while inputs the world may hold stay as they are
+                // (a sensor row beside the wait is no handling of X's error).
+                let (w, whatever) = match conditions.stalls_in(state, x, StatusId::ERROR, alive) {
+                    Some(w) => (w, true),
+                    // A row that reads X's error and waits on something
+                    // more (an acknowledgement) handles it by design.
+                    None if reads_error(p, state, x) => continue,
+                    None => match conditions.stalls_while(state, x, StatusId::ERROR, alive) {
+                        Some(w) => (w, false),
+                        None => continue,
+                    },
                 };
                 let Some(why) = *proved.get_or_init(|| proved_failure(ir, summaries, &p.rows, x))
                 else {
@@ -95,10 +105,18 @@ pub(crate) fn check_unhandled_error(sup: &Supervisor, sink: &mut Sink) {
                          `{sub}.stale_cycles` stays 0 and the watchdog on it never fires",
                         c.name
                     ))
-                } else {
+                } else if whatever {
                     d.with_note(format!(
                         "with `{sub}.status == ERROR` no row of `{state_name}` matches, whatever \
                          the other inputs: `{}` stays in `{state_name}` until a new command",
+                        c.name
+                    ))
+                } else {
+                    d.with_note(format!(
+                        "with `{sub}.status == ERROR` the rows of `{state_name}` that can still \
+                         match wait on other inputs: while those keep the values above, none \
+                         matches, however long `{}` waits — they are a way out, not a handling \
+                         of `{sub}`'s failure",
                         c.name
                     ))
                 };
@@ -133,5 +151,15 @@ fn reads_watchdog(p: &crate::ir::Plan, state: StateId, x: CtrlId) -> bool {
             });
         }
         found
+    })
+}
+
+/// Whether a row covering `state` tests `x` for `ERROR` (`x.error`,
+/// `x.status == ERROR`).
+fn reads_error(p: &crate::ir::Plan, state: StateId, x: CtrlId) -> bool {
+    p.rows.iter().filter(|r| covers(&r.from, state)).any(|r| {
+        status_tests(r, x)
+            .iter()
+            .any(|(s, _)| *s == StatusId::ERROR)
     })
 }

@@ -28,20 +28,7 @@ impl PlanAnalysis<'_> {
         status: StatusId,
         alive: bool,
     ) -> Option<Witness> {
-        if !self.analysed_over_cycles() {
-            return None;
-        }
-        let leaf = self.terms.find(&Leaf::SubStatus(sub))?;
-        let any = self.conditions_covering(state)?;
-        let mut fixed = self.fixed(state);
-        fixed.push((leaf, Value::Status(status.0 as u16)));
-        if let Some(stale) = alive
-            .then(|| self.terms.find(&Leaf::SubStale(sub)))
-            .flatten()
-        {
-            fixed.push((stale, Value::Int(0)));
-        }
-        let some_row = Formula::Or(any);
+        let (some_row, fixed) = self.stall_question(state, sub, status, alive)?;
         if !matches!(self.prove(&some_row, &fixed), Outcome::None) {
             return None;
         }
@@ -71,20 +58,7 @@ impl PlanAnalysis<'_> {
         status: StatusId,
         alive: bool,
     ) -> Option<Witness> {
-        if !self.analysed_over_cycles() {
-            return None;
-        }
-        let leaf = self.terms.find(&Leaf::SubStatus(sub))?;
-        let any = self.conditions_covering(state)?;
-        let mut fixed = self.fixed(state);
-        fixed.push((leaf, Value::Status(status.0 as u16)));
-        if let Some(stale) = alive
-            .then(|| self.terms.find(&Leaf::SubStale(sub)))
-            .flatten()
-        {
-            fixed.push((stale, Value::Int(0)));
-        }
-        let some_row = Formula::Or(any);
+        let (some_row, fixed) = self.stall_question(state, sub, status, alive)?;
         let none = Formula::Not(Box::new(some_row.clone()));
         let values = match Search::new(&self.terms, Mode::Witness, self.candidates(), &[], &fixed)
             .in_order(self.indexed)
@@ -107,6 +81,32 @@ impl PlanAnalysis<'_> {
             }
         }
         matches!(self.prove(&some_row, &held), Outcome::None).then_some(w)
+    }
+
+    /// What a stall in `state` asks: "some row of the state matches", and
+    /// the leaves fixed there (`sub` showing `status`; with `alive`, its
+    /// `stale_cycles` at 0).
+    fn stall_question(
+        &self,
+        state: StateId,
+        sub: CtrlId,
+        status: StatusId,
+        alive: bool,
+    ) -> Option<(Formula, Vec<(LeafId, Value)>)> {
+        if !self.analysed_over_cycles() {
+            return None;
+        }
+        let leaf = self.terms.find(&Leaf::SubStatus(sub))?;
+        let any = self.conditions_covering(state)?;
+        let mut fixed = self.fixed(state);
+        fixed.push((leaf, Value::Status(status.0 as u16)));
+        if let Some(stale) = alive
+            .then(|| self.terms.find(&Leaf::SubStale(sub)))
+            .flatten()
+        {
+            fixed.push((stale, Value::Int(0)));
+        }
+        Some((Formula::Or(any), fixed))
     }
 
     /// Whether the verb's `accept when` condition can be false on a

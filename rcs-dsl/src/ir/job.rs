@@ -127,6 +127,16 @@ pub fn visit_job_exprs<'a>(jobs: &'a [Job], f: &mut dyn FnMut(&'a Expr)) {
 impl Job {
     /// The subordinate a `Send` or `Forward` job commands, and the job's
     /// span: both are a send with a new serial to every check.
+    /// For a `Send` to `x`: the verb and the arguments.
+    pub fn send_to(&self, x: CtrlId) -> Option<(CommandId, &[Expr])> {
+        match self {
+            Job::Send {
+                sub, command, args, ..
+            } if *sub == x => Some((*command, args.as_slice())),
+            _ => None,
+        }
+    }
+
     pub fn sends_to(&self) -> Option<(CtrlId, Span)> {
         match self {
             Job::Send { sub, span, .. } | Job::Forward { sub, span, .. } => Some((*sub, *span)),

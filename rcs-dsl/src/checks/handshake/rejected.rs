@@ -107,17 +107,9 @@ pub(crate) fn rejections(
 
 /// A send to `x` whose arguments are all constants: (verb, values).
 pub(crate) fn constant_send(j: &Job, x: crate::ir::CtrlId) -> Option<(CommandId, Vec<Value>)> {
-    let Job::Send {
-        sub, command, args, ..
-    } = j
-    else {
-        return None;
-    };
-    if *sub != x {
-        return None;
-    }
+    let (command, args) = j.send_to(x)?;
     let values: Option<Vec<Value>> = args.iter().map(constant).collect();
-    Some((*command, values?))
+    Some((command, values?))
 }
 
 fn constant(e: &Expr) -> Option<Value> {

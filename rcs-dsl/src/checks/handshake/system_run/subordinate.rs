@@ -133,15 +133,7 @@ pub(super) fn passing_on(ir: &Ir, run: &Run, x: CtrlId) -> Option<Run> {
                 (out != *run).then_some(out)
             });
         }
-        let crate::ir::Job::Send {
-            sub, command, args, ..
-        } = j
-        else {
-            return None;
-        };
-        if *sub != x {
-            return None;
-        }
+        let (command, args) = j.send_to(x)?;
         let passed: Vec<(usize, usize)> = args
             .iter()
             .enumerate()
@@ -153,7 +145,7 @@ pub(super) fn passing_on(ir: &Ir, run: &Run, x: CtrlId) -> Option<Run> {
         if passed.is_empty() {
             return None;
         }
-        let wanted = failing_params(ir, x, *command)?;
+        let wanted = failing_params(ir, x, command)?;
         let theirs = &ir.controller(x).commands[command.index()].params;
         let mut out = run.clone();
         for (i, q) in passed {

@@ -342,6 +342,50 @@ fn cross_controller_witnesses_replay_in_rcsc_test() {
     assert!(with_error >= 1, "no case with an error of the checks");
 }
 
+/// A cross-controller finding's system run, as `--witnesses` writes it,
+/// passes on the generated code too: one case per lint that has one.
+#[test]
+fn cross_controller_system_runs_pass_on_the_compiled_backend() {
+    let target = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("rcsc-witness-driver");
+    for (i, case) in [
+        "tests/data/err/5101_unhandled_error_watchdog_on_live_subordinate.rcs",
+        "tests/data/err/5106_unhandled_error_timer_gated_on_another_subordinate.rcs",
+        "tests/data/err/5121_stale_subordinate_status_state_row_before_command.rcs",
+        "tests/data/err/5130_command_overwritten_no_wait.rcs",
+        "tests/data/err/5140_always_rejected_refused_by_limit.rcs",
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let dir = scratch(&format!("system-witnesses{i}"), &[]);
+        rcsc(&["check", case, "--witnesses", dir.to_str().unwrap()]);
+        let files: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path().to_string_lossy().into_owned())
+            .filter(|p| p.ends_with("_system.scenario.yaml"))
+            .collect();
+        assert_eq!(files.len(), 1, "{case}: one system run written");
+        let mut args = vec![
+            "test",
+            "--backend",
+            "compiled",
+            "--target-dir",
+            target.to_str().unwrap(),
+            case,
+        ];
+        args.extend(files.iter().map(String::as_str));
+        let out = rcsc(&args);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{case}: {}{}",
+            text(&out.stdout),
+            text(&out.stderr)
+        );
+        assert!(text(&out.stdout).contains("1 passed, 0 failed"));
+    }
+}
+
 /// `rcsc test CASE FILES…` passes: the witness scenarios written for a
 /// case replay on its plans.
 fn assert_replays(case: &str, files: &[String]) {

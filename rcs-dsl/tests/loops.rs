@@ -20,6 +20,7 @@ mod common;
 use proptest::prelude::*;
 use rcs_dsl::analysis::cycles::{command_storms, livelocks, Inputs, Step};
 use rcs_dsl::analysis::terms::{Leaf, Step as PathStep};
+use rcs_dsl::analysis::run::replay;
 use rcs_dsl::analysis::PlanAnalysis;
 use rcs_dsl::interp;
 use rcs_dsl::ir::{Controller, CtrlId, Ir, Plan, StatusId, Type};
@@ -196,6 +197,23 @@ fn replay_cases(
 fn replay_livelocks(case: &str, ir: &Ir, c: CtrlId, p: &Plan, a: &PlanAnalysis) -> usize {
     let locks = livelocks(ir.controller(c), p, a);
     for lock in &locks {
+        // The finding's run, its last step (round the ring) held for 1500
+        // cycles: the rows it names fire in turn, and no other.
+        if let Some(run) = &lock.run {
+            let mut long = run.clone();
+            if let Some(last) = long.steps.last_mut() {
+                last.cycles = 1500;
+            }
+            if let Err(e) = replay(ir, c, &long) {
+                panic!("{case}: the livelock's run does not go round: {e}");
+            }
+        }
+        // A ring reached by a run (a plan whose conditions read vars that
+        // jobs change) has no walk to replay: its run is its witness.
+        if lock.path.is_empty() {
+            assert!(lock.run.is_some(), "{case}: a ring with neither walk nor run");
+            continue;
+        }
         let mut rig = Rig::new(ir, c, p, &lock.params);
         rig.walk(&lock.path, case);
         rig.give(&lock.held);
@@ -246,6 +264,15 @@ fn replay_storms(case: &str, ir: &Ir, c: CtrlId, p: &Plan, a: &PlanAnalysis) -> 
 fn livelocks_go_round_on_the_interpreter() {
     let found = replay_cases("33", replay_livelocks);
     assert!(found >= 3, "only {found} livelocks replayed");
+}
+
+/// The livelock shapes of issue 27 (5200–5219): rings through `*N` rows,
+/// through a subordinate the plan commands and polls, and in plans whose
+/// conditions read vars that jobs change; each replays.
+#[test]
+fn livelock_shapes_go_round_on_the_interpreter() {
+    let found = replay_cases("52", replay_livelocks);
+    assert!(found >= 12, "only {found} livelocks replayed");
 }
 
 #[test]
@@ -311,8 +338,16 @@ fn random_plan() -> impl Strategy<Value = String> {
         prop::bool::ANY,
         prop::bool::ANY,
         prop::collection::vec(row(), 2..=7),
+        prop::bool::ANY,
     )
-        .prop_map(|(send, timeout, rows)| {
+        .prop_map(|(send, timeout, rows, slow)| {
+            // X answers at once, or (slow) only after a few cycles: then a
+            // ring through it can be a livelock.
+            let x_plan = if slow {
+                "*0 when new_command -> S1\n        S1 when state_cycles > 2 -> Done"
+            } else {
+                "* when new_command -> Done"
+            };
             let send = if send { " { X <- RUN }" } else { "" };
             // A timeout over every state, first, for rings to defeat.
             let timeout = if timeout {
@@ -332,7 +367,9 @@ controller P {{
 }}
 controller X {{
     command RUN
-    plan RUN {{ * when new_command -> Done }}
+    plan RUN {{
+        {x_plan}
+    }}
 }}
 ",
                 rows.concat()

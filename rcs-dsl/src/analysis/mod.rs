@@ -57,6 +57,7 @@ pub mod run;
 pub mod search;
 pub mod terms;
 pub mod value;
+mod rings;
 mod walk;
 
 use crate::ir::{Condition, Controller, CtrlId, Expr, ExprKind, From, Ir, Plan, StateId, Type};

@@ -11,7 +11,7 @@ use crate::analysis::cycles::{command_storms, livelocks};
 use crate::analysis::run::{self, Expect, Firing};
 use crate::analysis::PlanAnalysis;
 use crate::diagnostic::Diagnostic;
-use crate::ir::{Controller, Ir, Plan, StateId, Target};
+use crate::ir::{Controller, Ir, Plan, StateId};
 use crate::lint::Lint;
 
 /// `E3`, as the plan writes the row's position.
@@ -69,28 +69,9 @@ pub(crate) fn check_livelocks(c: &Controller, p: &Plan, an: &PlanAnalysis, sink:
                 state_name(p, t_state)
             ),
         );
-        // The run: the way to the ring, then three times round it.
-        let rows: Vec<Firing> = found
-            .cycle
-            .iter()
-            .filter_map(|&(r, _)| match p.rows[r].to {
-                Target::State(to) => Some(Firing {
-                    row: run::row_name(&p.rows[r]),
-                    state: state_name(p, to).to_string(),
-                }),
-                _ => None,
-            })
-            .collect();
-        let cycles = 3 * rows.len() as u32;
-        let run = (rows.len() == found.cycle.len())
-            .then(|| {
-                let expect = Expect::Repeats { rows };
-                an.finding_run(&found.params, first_state, &found.held, cycles, expect)
-            })
-            .flatten();
         let d = d
             .with_witness(state_name(p, first_state), &found.shown)
-            .with_run(run)
+            .with_run(found.run)
             .with_note(format!(
                 "with these inputs held, one row fires per cycle, round and round: {}; \
                  no other row of these states ever fires, a timeout included",

@@ -339,7 +339,38 @@ pub(super) fn path_ring(
         .into_iter()
         .filter_map(|l| value_of(an, &w.inputs, l).map(|v| (l, v.clone())))
         .collect();
-    let paths = an.paths_given(&params);
+    // The vars the ring reads may take their values from parameters the
+    // rows do not read (`fast = cmd.fast` on entry): other values of each
+    // parameter are tried too, a few.
+    let mut tries = vec![params.clone()];
+    for l in an.command_leaves().into_iter().take(MAX_PARAMS_TRIED) {
+        for v in an.cell_values(l).iter().take(MAX_VALUES_TRIED) {
+            let mut given: Vec<(LeafId, Value)> =
+                params.iter().filter(|(p, _)| *p != l).cloned().collect();
+            given.push((l, v.clone()));
+            if !tries.contains(&given) {
+                tries.push(given);
+            }
+        }
+    }
+    tries
+        .iter()
+        .find_map(|given| path_ring_given(walker, cycle, pcs, given))
+}
+
+/// How many parameters, and values of each, [`path_ring`] tries.
+const MAX_PARAMS_TRIED: usize = 4;
+const MAX_VALUES_TRIED: usize = 4;
+
+/// [`path_ring`] with the command's parameters at `params`.
+fn path_ring_given(
+    walker: &Walker,
+    cycle: &[(usize, StateId)],
+    pcs: &[u32],
+    params: &[(LeafId, Value)],
+) -> Option<PathRing> {
+    let an = walker.an;
+    let paths = an.paths_given(params);
     let ctrl_id = an.ctrl_id()?;
     for k in 0..cycle.len() {
         let state = cycle[k].1;

@@ -19,8 +19,8 @@ mod common;
 
 use proptest::prelude::*;
 use rcs_dsl::analysis::cycles::{command_storms, livelocks, Inputs, Step};
-use rcs_dsl::analysis::terms::{Leaf, Step as PathStep};
 use rcs_dsl::analysis::run::replay;
+use rcs_dsl::analysis::terms::{Leaf, Step as PathStep};
 use rcs_dsl::analysis::PlanAnalysis;
 use rcs_dsl::interp;
 use rcs_dsl::ir::{Controller, CtrlId, Ir, Plan, StatusId, Type};
@@ -211,7 +211,10 @@ fn replay_livelocks(case: &str, ir: &Ir, c: CtrlId, p: &Plan, a: &PlanAnalysis) 
         // A ring reached by a run (a plan whose conditions read vars that
         // jobs change) has no walk to replay: its run is its witness.
         if lock.path.is_empty() {
-            assert!(lock.run.is_some(), "{case}: a ring with neither walk nor run");
+            assert!(
+                lock.run.is_some(),
+                "{case}: a ring with neither walk nor run"
+            );
             continue;
         }
         let mut rig = Rig::new(ir, c, p, &lock.params);

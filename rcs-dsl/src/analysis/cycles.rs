@@ -8,13 +8,13 @@
 //! (`checks/loops.rs`) report them; `tests/loops.rs` replays them on the
 //! interpreter — one computation for both.
 
+use super::rings;
+use super::run::{self, Expect, Firing, Run};
 use super::terms::Leaf;
 use super::walk::{
     can, fires_on, is_counter, not_ready, sends, target_state, value_of, Held, Place, Walker,
 };
 pub use super::walk::{Inputs, Step};
-use super::rings;
-use super::run::{self, Expect, Firing, Run};
 use super::{covers, LeafId, PlanAnalysis};
 use crate::ir::{Controller, CtrlId, Plan, StateId, StatusId, Target};
 use rcs_runtime::driver::Value;
@@ -46,6 +46,9 @@ pub struct Livelock {
     /// three times round. Always there for a ring through a subordinate
     /// or reached by a run.
     pub run: Option<Run>,
+    /// The subordinates the ring commands and reads the status of: each
+    /// shows `EXECUTING` on the cycle after each command.
+    pub through: Vec<CtrlId>,
 }
 
 /// A row that sends a command on consecutive cycles while the subordinate
@@ -205,7 +208,13 @@ fn walked_ring(
     let (first_state, rows) = (cycle[0].1, ring_firings(plan, &cycle));
     let run = rows.and_then(|rows| {
         let cycles = 3 * rows.len() as u32;
-        an.finding_run(&params, first_state, &held, cycles, Expect::Repeats { rows })
+        an.finding_run(
+            &params,
+            first_state,
+            &held,
+            cycles,
+            Expect::Repeats { rows },
+        )
     });
     // A ring through a subordinate is a finding only with its run.
     if !through.is_empty() && run.is_none() {
@@ -219,6 +228,7 @@ fn walked_ring(
         params,
         path: at.path,
         run,
+        through: through.iter().map(|(x, _)| *x).collect(),
     })
 }
 
@@ -272,6 +282,7 @@ fn path_ring(
         params,
         path: Vec::new(),
         run: Some(run),
+        through: Vec::new(),
     })
 }
 

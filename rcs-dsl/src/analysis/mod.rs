@@ -53,11 +53,11 @@ mod handshake;
 pub mod index_range;
 mod names;
 pub mod path;
+mod rings;
 pub mod run;
 pub mod search;
 pub mod terms;
 pub mod value;
-mod rings;
 mod walk;
 
 use crate::ir::{Condition, Controller, CtrlId, Expr, ExprKind, From, Ir, Plan, StateId, Type};

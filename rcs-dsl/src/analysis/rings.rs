@@ -31,7 +31,7 @@ use super::terms::Leaf;
 use super::walk::{can, fires_on, is_counter, not_ready, sends, value_of, Held, Walker};
 use super::{covers, LeafId, PlanAnalysis, Witness};
 use crate::ir::{
-    CommandId, Condition, Controller, CtrlId, Expr, ExprKind, Ir, Job, Plan, PlaceRoot, StateId,
+    CommandId, Condition, Controller, CtrlId, Expr, ExprKind, Ir, Job, PlaceRoot, Plan, StateId,
     StatusId, Target,
 };
 use rcs_runtime::driver::{Driven as _, Value};
@@ -125,7 +125,10 @@ pub(super) fn through(
                 continue;
             };
             if !matches!(j, Job::Send { .. })
-                || !j.commands_sent().iter().all(|v| fresh.shows_executing(x, *v))
+                || !j
+                    .commands_sent()
+                    .iter()
+                    .all(|v| fresh.shows_executing(x, *v))
             {
                 return None;
             }
@@ -138,9 +141,10 @@ pub(super) fn through(
         return Some(out);
     }
     // Every-cycle jobs that command it too: not modelled.
-    let every_cycle_sends = ctrl
-        .every_cycle_jobs()
-        .any(|j| j.sends_to().is_some_and(|(x, _)| out.iter().any(|(y, _)| *y == x)));
+    let every_cycle_sends = ctrl.every_cycle_jobs().any(|j| {
+        j.sends_to()
+            .is_some_and(|(x, _)| out.iter().any(|(y, _)| *y == x))
+    });
     let other_reads = walker.an.terms().leaves.iter().any(|(l, _)| match l {
         Leaf::SubStale(x) | Leaf::SubErrorCode(x) | Leaf::SubField(x, ..) => {
             out.iter().any(|(y, _)| y == x)

@@ -23,7 +23,13 @@ fn state_name(p: &Plan, s: StateId) -> &str {
     p.states.get(s.index()).map_or("?", |s| s.name.as_str())
 }
 
-pub(crate) fn check_livelocks(c: &Controller, p: &Plan, an: &PlanAnalysis, sink: &mut Sink) {
+pub(crate) fn check_livelocks(
+    ir: &Ir,
+    c: &Controller,
+    p: &Plan,
+    an: &PlanAnalysis,
+    sink: &mut Sink,
+) {
     let verb = &c.plan_title(p);
     for found in livelocks(c, p, an) {
         let Some(&(first, first_state)) = found.cycle.first() else {
@@ -69,6 +75,21 @@ pub(crate) fn check_livelocks(c: &Controller, p: &Plan, an: &PlanAnalysis, sink:
                 state_name(p, t_state)
             ),
         );
+        for &x in &found.through {
+            let sub = &ir.controller(x).name;
+            d = d.with_note(format!(
+                "`{sub}` is commanded again on every round: on the cycle after each command it \
+                 shows EXECUTING (it runs at most once between two cycles of `{}`, and its plan \
+                 cannot answer on a command's first cycle), so it is restarted for ever",
+                c.name
+            ));
+        }
+        if found.path.is_empty() {
+            d = d.with_note(
+                "the vars these states read keep the values the way here leaves them: no row \
+                 of the ring, nor `pre` or `post`, assigns one",
+            );
+        }
         let d = d
             .with_witness(state_name(p, first_state), &found.shown)
             .with_run(found.run)

@@ -307,6 +307,8 @@ fn row() -> impl Strategy<Value = String> {
         "!X.executing",
         "X.status == NOT_READY",
         "X.error",
+        "n < 2",
+        "n >= 2",
     ]);
     let from = prop::sample::select(vec![
         "S1",
@@ -329,9 +331,17 @@ fn row() -> impl Strategy<Value = String> {
         prop::collection::vec(atom, 1..=2),
         to,
         prop::bool::weighted(0.3),
+        prop::bool::weighted(0.2),
     )
-        .prop_map(|(from, atoms, to, send)| {
-            let send = if send { " { X <- RUN }" } else { "" };
+        .prop_map(|(from, atoms, to, send, count)| {
+            // A row may count in `n`, which other rows read: such plans
+            // are not walked, their rings are reached by replayed runs.
+            let send = match (send, count) {
+                (true, true) => " { X <- RUN; n += 1 }",
+                (true, false) => " { X <- RUN }",
+                (false, true) => " { n += 1 }",
+                (false, false) => "",
+            };
             format!("        {from} when {} -> {to}{send}\n", atoms.join(" && "))
         })
 }
@@ -363,6 +373,7 @@ fn random_plan() -> impl Strategy<Value = String> {
 controller P {{
     subordinates X
     reads s: In
+    var n: u8 = 0
     command GO(k: u8)
     plan GO {{
         * when new_command -> S1{send}
@@ -386,6 +397,7 @@ controller X {{
 fn random_plans_replay_every_finding() {
     let mut runner = common::deterministic_runner("RCS_LOOPS_CASES", 800);
     let found = std::cell::Cell::new((0, 0));
+    let kinds = std::cell::Cell::new((0, 0));
     runner
         .run(&random_plan(), |text| {
             let set = rcs_dsl::PlanSet::from_texts("p", [("p.rcs", text.as_str())], None);
@@ -399,14 +411,24 @@ fn random_plans_replay_every_finding() {
                 l + replay_livelocks(&text, &ir, c, p, &a),
                 s + replay_storms(&text, &ir, c, p, &a),
             ));
+            let locks = livelocks(&ir.controllers[0], p, &a);
+            let (r, t) = kinds.get();
+            kinds.set((
+                r + locks.iter().filter(|l| l.path.is_empty()).count(),
+                t + locks.iter().filter(|l| !l.through.is_empty()).count(),
+            ));
             Ok(())
         })
         .unwrap();
     let (locks, storms) = found.get();
-    eprintln!("loops: 800 random plans; {locks} livelocks, {storms} command storms replayed");
+    let (by_run, through) = kinds.get();
+    eprintln!(
+        "loops: 800 random plans; {locks} livelocks ({by_run} reached by a run, {through} \
+         through X), {storms} command storms replayed"
+    );
     assert!(
-        locks >= 5 && storms >= 5,
-        "{locks} livelocks, {storms} storms"
+        locks >= 5 && storms >= 5 && by_run >= 1 && through >= 1,
+        "{locks} livelocks ({by_run} by a run, {through} through X), {storms} storms"
     );
 }
 
@@ -427,4 +449,49 @@ fn clean_cases_have_no_loops() {
             }
         }
     }
+}
+
+/// The rings of the golden cases through a subordinate, on the whole plan
+/// set: with the ring's inputs held from the start, the real subordinate
+/// (not a status the test gives) is commanded again on every round and
+/// the supervisor is still executing 400 ticks later: its timeout,
+/// shorter than that, never fired.
+#[test]
+fn rings_through_a_subordinate_hold_in_the_whole_system() {
+    let mut checked = 0;
+    for case in cases("52") {
+        let ir = load(&case);
+        for c in &ir.controllers {
+            for p in &c.plans {
+                let a = PlanAnalysis::new(&ir, c, p);
+                for lock in livelocks(c, p, &a) {
+                    if lock.through.is_empty() {
+                        continue;
+                    }
+                    let run = lock.run.as_ref().expect("a ring through X has a run");
+                    let reads = &run.steps.last().expect("a step").reads;
+                    let command = if run.params.is_empty() {
+                        serde_json::json!(run.command)
+                    } else {
+                        serde_json::json!({ &run.command: run.params })
+                    };
+                    let mut expect = serde_json::Map::new();
+                    expect.insert(c.name.clone(), serde_json::json!({ "status": "EXECUTING" }));
+                    let text = format!(
+                        "name: ring\nsystem: true\ninitial:\n  reads: {}\nsteps:\n  - command: {}\n    cycles: 400\n    expect: {}\n",
+                        serde_json::to_string(reads).unwrap(),
+                        command,
+                        serde_json::Value::Object(expect),
+                    );
+                    let script = rcs_dsl::scenario::SystemScript::from_yaml(&ir, &text, "ring")
+                        .unwrap_or_else(|e| panic!("{case}: {e:?}\n{text}"));
+                    let outcome = rcs_dsl::scenario::run_script(&ir, &script)
+                        .unwrap_or_else(|e| panic!("{case}: {e:?}"));
+                    assert_eq!(outcome.failure, None, "{case}:\n{text}");
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert!(checked >= 5, "only {checked} rings through a subordinate");
 }

@@ -78,9 +78,10 @@ pub(crate) fn check_livelocks(
         for &x in &found.through {
             let sub = &ir.controller(x).name;
             d = d.with_note(format!(
-                "`{sub}` is commanded again on every round: on the cycle after each command it \
-                 shows EXECUTING (it runs at most once between two cycles of `{}`, and its plan \
-                 cannot answer on a command's first cycle), so it is restarted for ever",
+                "`{sub}` is commanded again on every round, and on the cycle after each \
+                 command it shows EXECUTING (it runs at most once between two cycles of `{}`, \
+                 and its plan cannot answer on a command's first cycle): the ring never waits \
+                 for its answer",
                 c.name
             ));
         }

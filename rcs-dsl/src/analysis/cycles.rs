@@ -113,6 +113,7 @@ pub fn livelocks(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<Livel
         None => vec![1],
     };
     let fresh = rings::Fresh::new(an);
+    let mut paths = rings::Paths::default();
     let mut found = Vec::new();
     for cycle in rings {
         // Sending to a subordinate whose status the rows read changes what
@@ -124,7 +125,7 @@ pub fn livelocks(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<Livel
         let lock = if walks {
             walked_ring(&walker, plan, cycle, &plan_cycle_values, &through)
         } else if through.is_empty() {
-            path_ring(&walker, ctrl, &cycle, &plan_cycle_values)
+            path_ring(&walker, ctrl, &cycle, &plan_cycle_values, &mut paths)
         } else {
             None
         };
@@ -239,6 +240,7 @@ fn path_ring(
     ctrl: &Controller,
     cycle: &[(usize, StateId)],
     plan_cycle_values: &[u32],
+    paths: &mut rings::Paths,
 ) -> Option<Livelock> {
     let an = walker.an;
     let rings::PathRing {
@@ -246,7 +248,7 @@ fn path_ring(
         held,
         base,
         prefix,
-    } = rings::path_ring(walker, ctrl, cycle, plan_cycle_values)?;
+    } = rings::path_ring(walker, ctrl, cycle, plan_cycle_values, paths)?;
     let mut pins = base.clone();
     pins.extend(held.pins.iter().cloned());
     let (defeated, extra) = defeated_row(an, walker.plan, &cycle, &pins)?;

@@ -328,6 +328,7 @@ pub(super) fn path_ring(
     ctrl: &Controller,
     cycle: &[(usize, StateId)],
     pcs: &[u32],
+    paths: &mut Paths,
 ) -> Option<PathRing> {
     let (an, plan) = (walker.an, walker.plan);
     if ring_changes_what_it_reads(ctrl, plan, cycle) {
@@ -357,24 +358,50 @@ pub(super) fn path_ring(
             }
         }
     }
-    tries
-        .iter()
-        .find_map(|given| path_ring_given(walker, cycle, pcs, given))
+    tries.iter().find_map(|given| {
+        let found = paths.given(an, given)?;
+        path_ring_given(walker, cycle, pcs, found)
+    })
 }
 
 /// How many parameters, and values of each, [`path_ring`] tries.
 const MAX_PARAMS_TRIED: usize = 4;
 const MAX_VALUES_TRIED: usize = 4;
 
-/// [`path_ring`] with the command's parameters at `params`.
+/// How many path searches (each replays runs on the interpreter) the
+/// rings of one plan may ask for: past it, nothing more is said.
+const MAX_PATH_SEARCHES: usize = 8;
+
+/// The runs to each state of one plan, per set of parameters pinned,
+/// searched once and shared by its rings, within [`MAX_PATH_SEARCHES`].
+#[derive(Default)]
+pub(super) struct Paths {
+    searched: Vec<(Vec<(LeafId, Value)>, Vec<Option<Run>>)>,
+}
+
+impl Paths {
+    fn given(&mut self, an: &PlanAnalysis, params: &[(LeafId, Value)]) -> Option<&[Option<Run>]> {
+        let at = match self.searched.iter().position(|(p, _)| p == params) {
+            Some(i) => i,
+            None if self.searched.len() < MAX_PATH_SEARCHES => {
+                self.searched
+                    .push((params.to_vec(), an.paths_given(params)));
+                self.searched.len() - 1
+            }
+            None => return None,
+        };
+        Some(&self.searched[at].1)
+    }
+}
+
+/// [`path_ring`] with the runs to each state for one set of parameters.
 fn path_ring_given(
     walker: &Walker,
     cycle: &[(usize, StateId)],
     pcs: &[u32],
-    params: &[(LeafId, Value)],
+    paths: &[Option<Run>],
 ) -> Option<PathRing> {
     let an = walker.an;
-    let paths = an.paths_given(params);
     let ctrl_id = an.ctrl_id()?;
     for k in 0..cycle.len() {
         let state = cycle[k].1;

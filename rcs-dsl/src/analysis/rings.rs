@@ -107,9 +107,10 @@ pub fn shows_executing_after_send(ir: &Ir, sup: CtrlId, x: CtrlId, verb: Command
 }
 
 /// The subordinates a ring goes through: those its rows send to whose
-/// status the conditions read, with their status leaf. `None` when one of
-/// them is not modelled: a send [`Fresh`] cannot vouch for, or the
-/// conditions read its `stale_cycles`, status fields or error code.
+/// status the conditions read, with their status leaf (one at most).
+/// `None` when they are not modelled: a send [`Fresh`] cannot vouch for,
+/// every-cycle jobs that command one, conditions that read its
+/// `stale_cycles`, status fields or error code, or two subordinates.
 pub(super) fn through(
     walker: &Walker,
     plan: &Plan,
@@ -139,6 +140,11 @@ pub(super) fn through(
     }
     if out.is_empty() {
         return Some(out);
+    }
+    // Two or more: what each shows on the cycles between would have to be
+    // taken together; not modelled.
+    if out.len() > 1 {
+        return None;
     }
     // Every-cycle jobs that command it too: not modelled.
     let every_cycle_sends = ctrl.every_cycle_jobs().any(|j| {

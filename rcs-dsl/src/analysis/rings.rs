@@ -382,8 +382,11 @@ const MAX_PATH_SEARCHES: usize = 8;
 /// searched once and shared by its rings, within [`MAX_PATH_SEARCHES`].
 #[derive(Default)]
 pub(super) struct Paths {
-    searched: Vec<(Vec<(LeafId, Value)>, Vec<Option<Run>>)>,
+    searched: Vec<Searched>,
 }
+
+/// The parameters pinned, and per state the run found to it.
+type Searched = (Vec<(LeafId, Value)>, Vec<Option<Run>>);
 
 impl Paths {
     fn given(&mut self, an: &PlanAnalysis, params: &[(LeafId, Value)]) -> Option<&[Option<Run>]> {

@@ -19,6 +19,7 @@ mod common;
 
 use proptest::prelude::*;
 use rcs_dsl::analysis::cycles::{command_storms, livelocks, Inputs, Step};
+use rcs_dsl::analysis::run::replay;
 use rcs_dsl::analysis::terms::{Leaf, Step as PathStep};
 use rcs_dsl::analysis::PlanAnalysis;
 use rcs_dsl::interp;
@@ -196,6 +197,26 @@ fn replay_cases(
 fn replay_livelocks(case: &str, ir: &Ir, c: CtrlId, p: &Plan, a: &PlanAnalysis) -> usize {
     let locks = livelocks(ir.controller(c), p, a);
     for lock in &locks {
+        // The finding's run, its last step (round the ring) held for 1500
+        // cycles: the rows it names fire in turn, and no other.
+        if let Some(run) = &lock.run {
+            let mut long = run.clone();
+            if let Some(last) = long.steps.last_mut() {
+                last.cycles = 1500;
+            }
+            if let Err(e) = replay(ir, c, &long) {
+                panic!("{case}: the livelock's run does not go round: {e}");
+            }
+        }
+        // A ring reached by a run (a plan whose conditions read vars that
+        // jobs change) has no walk to replay: its run is its witness.
+        if lock.path.is_empty() {
+            assert!(
+                lock.run.is_some(),
+                "{case}: a ring with neither walk nor run"
+            );
+            continue;
+        }
         let mut rig = Rig::new(ir, c, p, &lock.params);
         rig.walk(&lock.path, case);
         rig.give(&lock.held);
@@ -248,6 +269,15 @@ fn livelocks_go_round_on_the_interpreter() {
     assert!(found >= 3, "only {found} livelocks replayed");
 }
 
+/// The livelock shapes of issue 27 (5200–5219): rings through `*N` rows,
+/// through a subordinate the plan commands and polls, and in plans whose
+/// conditions read vars that jobs change; each replays.
+#[test]
+fn livelock_shapes_go_round_on_the_interpreter() {
+    let found = replay_cases("52", replay_livelocks);
+    assert!(found >= 12, "only {found} livelocks replayed");
+}
+
 #[test]
 fn command_storms_send_on_consecutive_cycles_on_the_interpreter() {
     let found = replay_cases("34", replay_storms);
@@ -277,6 +307,8 @@ fn row() -> impl Strategy<Value = String> {
         "!X.executing",
         "X.status == NOT_READY",
         "X.error",
+        "n < 2",
+        "n >= 2",
     ]);
     let from = prop::sample::select(vec![
         "S1",
@@ -299,9 +331,17 @@ fn row() -> impl Strategy<Value = String> {
         prop::collection::vec(atom, 1..=2),
         to,
         prop::bool::weighted(0.3),
+        prop::bool::weighted(0.2),
     )
-        .prop_map(|(from, atoms, to, send)| {
-            let send = if send { " { X <- RUN }" } else { "" };
+        .prop_map(|(from, atoms, to, send, count)| {
+            // A row may count in `n`, which other rows read: such plans
+            // are not walked, their rings are reached by replayed runs.
+            let send = match (send, count) {
+                (true, true) => " { X <- RUN; n += 1 }",
+                (true, false) => " { X <- RUN }",
+                (false, true) => " { n += 1 }",
+                (false, false) => "",
+            };
             format!("        {from} when {} -> {to}{send}\n", atoms.join(" && "))
         })
 }
@@ -311,8 +351,16 @@ fn random_plan() -> impl Strategy<Value = String> {
         prop::bool::ANY,
         prop::bool::ANY,
         prop::collection::vec(row(), 2..=7),
+        prop::bool::ANY,
     )
-        .prop_map(|(send, timeout, rows)| {
+        .prop_map(|(send, timeout, rows, slow)| {
+            // X answers at once, or (slow) only after a few cycles: then a
+            // ring through it can be a livelock.
+            let x_plan = if slow {
+                "*0 when new_command -> S1\n        S1 when state_cycles > 2 -> Done"
+            } else {
+                "* when new_command -> Done"
+            };
             let send = if send { " { X <- RUN }" } else { "" };
             // A timeout over every state, first, for rings to defeat.
             let timeout = if timeout {
@@ -325,6 +373,7 @@ fn random_plan() -> impl Strategy<Value = String> {
 controller P {{
     subordinates X
     reads s: In
+    var n: u8 = 0
     command GO(k: u8)
     plan GO {{
         * when new_command -> S1{send}
@@ -332,7 +381,9 @@ controller P {{
 }}
 controller X {{
     command RUN
-    plan RUN {{ * when new_command -> Done }}
+    plan RUN {{
+        {x_plan}
+    }}
 }}
 ",
                 rows.concat()
@@ -346,6 +397,7 @@ controller X {{
 fn random_plans_replay_every_finding() {
     let mut runner = common::deterministic_runner("RCS_LOOPS_CASES", 800);
     let found = std::cell::Cell::new((0, 0));
+    let kinds = std::cell::Cell::new((0, 0));
     runner
         .run(&random_plan(), |text| {
             let set = rcs_dsl::PlanSet::from_texts("p", [("p.rcs", text.as_str())], None);
@@ -359,14 +411,24 @@ fn random_plans_replay_every_finding() {
                 l + replay_livelocks(&text, &ir, c, p, &a),
                 s + replay_storms(&text, &ir, c, p, &a),
             ));
+            let locks = livelocks(&ir.controllers[0], p, &a);
+            let (r, t) = kinds.get();
+            kinds.set((
+                r + locks.iter().filter(|l| l.path.is_empty()).count(),
+                t + locks.iter().filter(|l| !l.through.is_empty()).count(),
+            ));
             Ok(())
         })
         .unwrap();
     let (locks, storms) = found.get();
-    eprintln!("loops: 800 random plans; {locks} livelocks, {storms} command storms replayed");
+    let (by_run, through) = kinds.get();
+    eprintln!(
+        "loops: 800 random plans; {locks} livelocks ({by_run} reached by a run, {through} \
+         through X), {storms} command storms replayed"
+    );
     assert!(
-        locks >= 5 && storms >= 5,
-        "{locks} livelocks, {storms} storms"
+        locks >= 5 && storms >= 5 && by_run >= 1 && through >= 1,
+        "{locks} livelocks ({by_run} by a run, {through} through X), {storms} storms"
     );
 }
 
@@ -387,4 +449,49 @@ fn clean_cases_have_no_loops() {
             }
         }
     }
+}
+
+/// The rings of the golden cases through a subordinate, on the whole plan
+/// set: with the ring's inputs held from the start, the real subordinate
+/// (not a status the test gives) is commanded again on every round and
+/// the supervisor is still executing 400 ticks later: its timeout,
+/// shorter than that, never fired.
+#[test]
+fn rings_through_a_subordinate_hold_in_the_whole_system() {
+    let mut checked = 0;
+    for case in cases("52") {
+        let ir = load(&case);
+        for c in &ir.controllers {
+            for p in &c.plans {
+                let a = PlanAnalysis::new(&ir, c, p);
+                for lock in livelocks(c, p, &a) {
+                    if lock.through.is_empty() {
+                        continue;
+                    }
+                    let run = lock.run.as_ref().expect("a ring through X has a run");
+                    let reads = &run.steps.last().expect("a step").reads;
+                    let command = if run.params.is_empty() {
+                        serde_json::json!(run.command)
+                    } else {
+                        serde_json::json!({ &run.command: run.params })
+                    };
+                    let mut expect = serde_json::Map::new();
+                    expect.insert(c.name.clone(), serde_json::json!({ "status": "EXECUTING" }));
+                    let text = format!(
+                        "name: ring\nsystem: true\ninitial:\n  reads: {}\nsteps:\n  - command: {}\n    cycles: 400\n    expect: {}\n",
+                        serde_json::to_string(reads).unwrap(),
+                        command,
+                        serde_json::Value::Object(expect),
+                    );
+                    let script = rcs_dsl::scenario::SystemScript::from_yaml(&ir, &text, "ring")
+                        .unwrap_or_else(|e| panic!("{case}: {e:?}\n{text}"));
+                    let outcome = rcs_dsl::scenario::run_script(&ir, &script)
+                        .unwrap_or_else(|e| panic!("{case}: {e:?}"));
+                    assert_eq!(outcome.failure, None, "{case}:\n{text}");
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert!(checked >= 5, "only {checked} rings through a subordinate");
 }

@@ -8,6 +8,8 @@
 //! (`checks/loops.rs`) report them; `tests/loops.rs` replays them on the
 //! interpreter — one computation for both.
 
+use super::rings;
+use super::run::{self, Expect, Firing, Run};
 use super::terms::Leaf;
 use super::walk::{
     can, fires_on, is_counter, not_ready, sends, target_state, value_of, Held, Place, Walker,
@@ -36,8 +38,17 @@ pub struct Livelock {
     pub shown: Vec<(String, String)>,
     /// The command's parameters (those the conditions read).
     pub params: Vec<(Leaf, Value)>,
-    /// The way from the entry to the first state of `cycle`.
+    /// The way from the entry to the first state of `cycle`, as a walk
+    /// (empty for a ring reached by a run: a plan whose conditions read
+    /// vars that jobs change).
     pub path: Vec<Step>,
+    /// The run, replayed on the interpreter: the way to the ring, then
+    /// three times round. Always there for a ring through a subordinate
+    /// or reached by a run.
+    pub run: Option<Run>,
+    /// The subordinates the ring commands and reads the status of: each
+    /// shows `EXECUTING` on the cycle after each command.
+    pub through: Vec<CtrlId>,
 }
 
 /// A row that sends a command on consecutive cycles while the subordinate
@@ -56,7 +67,10 @@ pub struct CommandStorm {
     pub params: Vec<(Leaf, Value)>,
 }
 
-/// The livelocks of one plan, each reachable from the entry.
+/// The livelocks of one plan, each reachable from the entry. A ring
+/// through a subordinate the rows poll and command, or in a plan whose
+/// conditions read vars that jobs change (`rings.rs`), is found only with
+/// its run replayed on the interpreter.
 pub fn livelocks(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<Livelock> {
     if !an.analysed_over_cycles() {
         return Vec::new();
@@ -66,8 +80,10 @@ pub fn livelocks(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<Livel
     if rings.is_empty() {
         return Vec::new();
     }
-    let Some(walker) = Walker::new(ctrl, plan, an) else {
-        return Vec::new();
+    // Conditions that read vars jobs change: no walk, a replayed run.
+    let (walker, walks) = match Walker::new(ctrl, plan, an) {
+        Some(w) => (w, true),
+        None => (Walker::lenient(ctrl, plan, an), false),
     };
     // `plan_cycles` keeps growing round the loop: the rows must fire for
     // every value, which its cells decide, unless an opaque atom reads it.
@@ -96,101 +112,195 @@ pub fn livelocks(ctrl: &Controller, plan: &Plan, an: &PlanAnalysis) -> Vec<Livel
         }
         None => vec![1],
     };
+    let fresh = rings::Fresh::new(an);
+    let mut paths = rings::Paths::default();
     let mut found = Vec::new();
     for cycle in rings {
         // Sending to a subordinate whose status the rows read changes what
-        // they read (the handshake shows it EXECUTING): not constant.
-        if cycle.iter().any(|(r, _)| {
-            sends(&plan.rows[*r]).any(|x| walker.statuses.iter().any(|(s, _)| *s == x))
-        }) {
-            continue;
-        }
-        let Some(first) = plan_cycle_values.first() else {
+        // they read: only a send after which the handshake surely shows
+        // it EXECUTING is modelled.
+        let Some(through) = rings::through(&walker, plan, ctrl, &cycle, &fresh) else {
             continue;
         };
-        let mut pins = walker.counter_pins(1, *first);
-        pins.extend(walker.constant.iter().cloned());
-        let Some(w) = can(an.can_fire_all_given(&cycle, &pins)) else {
-            continue;
+        let lock = if walks {
+            walked_ring(&walker, plan, cycle, &plan_cycle_values, &through)
+        } else if through.is_empty() {
+            path_ring(&walker, ctrl, &cycle, &plan_cycle_values, &mut paths)
+        } else {
+            None
         };
-        let mut held = Held::of(an, &w);
-        // A leaf the first witness left open may matter at a later value
-        // of `plan_cycles`: hold the value the rows need there too (the
-        // rows fired before whatever its value, so they still do).
-        for pc in &plan_cycle_values {
-            for &(r, s) in &cycle {
-                let mut pins = walker.counter_pins(1, *pc);
-                pins.extend(held.pins.iter().cloned());
-                if let Some(w) = can(an.can_fire_in_given(r, s, &pins)) {
-                    held.extend(an, &w);
-                }
-            }
-        }
-        let Held {
-            inputs: held,
-            pins: held_pins,
-            shown,
-        } = held;
-        let holds_for = |pc: u32| {
-            cycle.iter().all(|&(r, s)| {
-                let mut pins = walker.counter_pins(1, pc);
-                pins.extend(held_pins.iter().cloned());
-                fires_on(an, r, s, &pins)
-            })
-        };
-        if !plan_cycle_values.iter().all(|pc| holds_for(*pc)) {
-            continue;
-        }
-        // A loop is a fault when it keeps another row from firing: one that
-        // would fire, with the same inputs, had the plan stayed in the
-        // state (a timeout). The inputs that row reads and the loop does
-        // not are held too.
-        let Some((defeated, extra)) = defeated_row(an, plan, &cycle, &held_pins) else {
-            continue;
-        };
-        let mut held = held;
-        for (l, v) in extra.into_iter().filter(|(l, _)| !is_counter(l)) {
-            if terms
-                .find(&l)
-                .is_some_and(|id| value_of(an, &held, id).is_none())
-            {
-                held.push((l, v));
-            }
-        }
-        // Reach the loop with the same parameters, on a first cycle in one
-        // of its states, having commanded exactly the subordinates that the
-        // held statuses say have answered.
-        let params: Vec<(LeafId, Value)> = an
-            .command_leaves()
-            .into_iter()
-            .filter_map(|l| value_of(an, &held, l).map(|v| (l, v.clone())))
-            .collect();
-        let consistent = |at: &Place| {
-            walker
-                .statuses
-                .iter()
-                .all(|(x, leaf)| match value_of(an, &held, *leaf) {
-                    None => true,
-                    Some(v) => (*v == not_ready()) != at.sent.contains(x),
-                })
-        };
-        let entry = walker.first(params, &|at| {
-            at.state_cycles == 1 && cycle.iter().any(|(_, s)| *s == at.state) && consistent(at)
-        });
-        let Some(at) = entry else { continue };
-        let start = cycle.iter().position(|(_, s)| *s == at.state).unwrap_or(0);
-        let mut cycle = cycle;
-        cycle.rotate_left(start);
-        found.push(Livelock {
-            defeated,
-            cycle,
-            held,
-            shown,
-            params: walker.params(&at.pinned),
-            path: at.path,
-        });
+        found.extend(lock);
     }
     found
+}
+
+/// A ring reached by a walk from the entry (the plan's conditions read no
+/// var a job changes).
+fn walked_ring(
+    walker: &Walker,
+    plan: &Plan,
+    cycle: Vec<(usize, StateId)>,
+    plan_cycle_values: &[u32],
+    through: &[(CtrlId, LeafId)],
+) -> Option<Livelock> {
+    let an = walker.an;
+    let terms = an.terms();
+    let Held {
+        inputs: held,
+        pins: held_pins,
+        shown,
+    } = rings::ring_inputs(walker, &cycle, &walker.constant, plan_cycle_values, through)?;
+    // Through a subordinate: each row fires whatever it shows, or just
+    // after a row that commands it (it then surely shows EXECUTING).
+    let mut all_pins = walker.constant.clone();
+    all_pins.extend(held_pins.iter().cloned());
+    let robust = rings::robust(walker, &cycle, &all_pins, through, plan_cycle_values);
+    if !rings::certain_round(plan, &cycle, &robust, through) {
+        return None;
+    }
+    // A loop is a fault when it keeps another row from firing: one that
+    // would fire, with the same inputs, had the plan stayed in the state
+    // (a timeout). The inputs that row reads and the loop does not are
+    // held too.
+    let (defeated, extra) = defeated_row(an, plan, &cycle, &held_pins)?;
+    let mut held = held;
+    for (l, v) in extra.into_iter().filter(|(l, _)| !is_counter(l)) {
+        if terms
+            .find(&l)
+            .is_some_and(|id| value_of(an, &held, id).is_none())
+        {
+            held.push((l, v));
+        }
+    }
+    // Reach the loop with the same parameters, on a first cycle in one
+    // of its states, having commanded exactly the subordinates that the
+    // held statuses say have answered; through a subordinate, on a
+    // position whose row fires whatever it shows, or just after a send.
+    let params: Vec<(LeafId, Value)> = an
+        .command_leaves()
+        .into_iter()
+        .filter_map(|l| value_of(an, &held, l).map(|v| (l, v.clone())))
+        .collect();
+    let consistent = |at: &Place| {
+        walker
+            .statuses
+            .iter()
+            .all(|(x, leaf)| match value_of(an, &held, *leaf) {
+                None => true,
+                Some(v) => (*v == not_ready()) != at.sent.contains(x),
+            })
+    };
+    let enters = |at: &Place| {
+        let Some(k) = cycle.iter().position(|(_, s)| *s == at.state) else {
+            return false;
+        };
+        let just_sent = at.path.last().and_then(|s| s.row).is_some_and(|r| {
+            through
+                .iter()
+                .all(|(x, _)| sends(&plan.rows[r]).any(|y| y == *x))
+        });
+        at.state_cycles == 1 && consistent(at) && (robust[k] || just_sent)
+    };
+    let at = walker.first(params, &enters)?;
+    let start = cycle.iter().position(|(_, s)| *s == at.state).unwrap_or(0);
+    let mut cycle = cycle;
+    cycle.rotate_left(start);
+    let params = walker.params(&at.pinned);
+    let (first_state, rows) = (cycle[0].1, ring_firings(plan, &cycle));
+    let run = rows.and_then(|rows| {
+        let cycles = 3 * rows.len() as u32;
+        an.finding_run(
+            &params,
+            first_state,
+            &held,
+            cycles,
+            Expect::Repeats { rows },
+        )
+    });
+    // A ring through a subordinate is a finding only with its run.
+    if !through.is_empty() && run.is_none() {
+        return None;
+    }
+    Some(Livelock {
+        defeated,
+        cycle,
+        held,
+        shown,
+        params,
+        path: at.path,
+        run,
+        through: through.iter().map(|(x, _)| *x).collect(),
+    })
+}
+
+/// A ring in a plan whose conditions read vars that jobs change: reached
+/// by a replayed run, reported only with its run round the ring replayed.
+fn path_ring(
+    walker: &Walker,
+    ctrl: &Controller,
+    cycle: &[(usize, StateId)],
+    plan_cycle_values: &[u32],
+    paths: &mut rings::Paths,
+) -> Option<Livelock> {
+    let an = walker.an;
+    let rings::PathRing {
+        cycle,
+        held,
+        base,
+        prefix,
+    } = rings::path_ring(walker, ctrl, cycle, plan_cycle_values, paths)?;
+    let mut pins = base.clone();
+    pins.extend(held.pins.iter().cloned());
+    let (defeated, extra) = defeated_row(an, walker.plan, &cycle, &pins)?;
+    let Held {
+        inputs: mut held,
+        shown,
+        ..
+    } = held;
+    for (l, v) in extra.into_iter().filter(|(l, _)| !is_counter(l)) {
+        let settable = matches!(l, Leaf::Buffer(..) | Leaf::Call(..) | Leaf::SubStatus(_));
+        if settable
+            && an
+                .terms()
+                .find(&l)
+                .is_some_and(|id| value_of(an, &held, id).is_none())
+        {
+            held.push((l, v));
+        }
+    }
+    let run = rings::ring_run(an, &prefix, &cycle, &held)?;
+    let params = walker.params(
+        &base
+            .iter()
+            .filter(|(l, _)| an.command_leaves().contains(l))
+            .cloned()
+            .collect::<Vec<_>>(),
+    );
+    Some(Livelock {
+        defeated,
+        cycle,
+        held,
+        shown,
+        params,
+        path: Vec::new(),
+        run: Some(run),
+        through: Vec::new(),
+    })
+}
+
+/// The rows of a ring as a run names them, with the state each leaves the
+/// plan in.
+fn ring_firings(plan: &Plan, cycle: &[(usize, StateId)]) -> Option<Vec<Firing>> {
+    cycle
+        .iter()
+        .map(|&(r, _)| match plan.rows[r].to {
+            Target::State(to) => Some(Firing {
+                row: run::row_name(&plan.rows[r]),
+                state: plan.states.get(to.index())?.name.clone(),
+            }),
+            _ => None,
+        })
+        .collect()
 }
 
 /// The command storms of one plan: per row and subordinate, the first one

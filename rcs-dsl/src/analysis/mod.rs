@@ -53,6 +53,7 @@ mod handshake;
 pub mod index_range;
 mod names;
 pub mod path;
+mod rings;
 pub mod run;
 pub mod search;
 pub mod terms;

@@ -124,13 +124,32 @@ impl<'a, 'ir> Walker<'a, 'ir> {
         plan: &'a Plan,
         an: &'a PlanAnalysis<'ir>,
     ) -> Option<Self> {
+        let (walker, constant) = Self::build(ctrl, plan, an);
+        constant.then_some(walker)
+    }
+
+    /// [`new`](Self::new) for a plan whose conditions read vars or `writes`
+    /// buffers that jobs change: those are left out of
+    /// [`constant`](Self::constant), for the caller to pin from a run
+    /// (`rings.rs`). Not for walks: [`step`](Self::step) would leave them
+    /// free.
+    pub(super) fn lenient(ctrl: &Controller, plan: &'a Plan, an: &'a PlanAnalysis<'ir>) -> Self {
+        Self::build(ctrl, plan, an).0
+    }
+
+    /// The walker, and whether every var and buffer the conditions read
+    /// keeps one value over a command (no job assigns it).
+    fn build(ctrl: &Controller, plan: &'a Plan, an: &'a PlanAnalysis<'ir>) -> (Self, bool) {
+        let mut all_constant = true;
         let constant_vars = an.constant_vars();
         let mut statuses = Vec::new();
         let mut constant = constant_vars.clone();
         for (id, (leaf, _)) in an.terms().leaves.iter().enumerate() {
             match leaf {
-                Leaf::Var(..) if !constant_vars.iter().any(|(l, _)| *l == id) => return None,
-                Leaf::Buffer(b, _) if ctrl.writes.contains(b) => return None,
+                Leaf::Var(..) if !constant_vars.iter().any(|(l, _)| *l == id) => {
+                    all_constant = false
+                }
+                Leaf::Buffer(b, _) if ctrl.writes.contains(b) => all_constant = false,
                 Leaf::SubStatus(x) => statuses.push((*x, id)),
                 // Every status and `reads` buffer is written each cycle
                 // in the runs the walk builds: never stale.
@@ -144,13 +163,14 @@ impl<'a, 'ir> Walker<'a, 'ir> {
             find(Leaf::StateCycles),
             find(Leaf::PlanCycles),
         ];
-        Some(Walker {
+        let walker = Walker {
             plan,
             an,
             statuses,
             constant,
             counters,
-        })
+        };
+        (walker, all_constant)
     }
 
     /// The leaves pinned on a cycle: the counters, the constants, the

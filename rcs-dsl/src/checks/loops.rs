@@ -11,7 +11,7 @@ use crate::analysis::cycles::{command_storms, livelocks};
 use crate::analysis::run::{self, Expect, Firing};
 use crate::analysis::PlanAnalysis;
 use crate::diagnostic::Diagnostic;
-use crate::ir::{Controller, Ir, Plan, StateId, Target};
+use crate::ir::{Controller, Ir, Plan, StateId};
 use crate::lint::Lint;
 
 /// `E3`, as the plan writes the row's position.
@@ -23,7 +23,13 @@ fn state_name(p: &Plan, s: StateId) -> &str {
     p.states.get(s.index()).map_or("?", |s| s.name.as_str())
 }
 
-pub(crate) fn check_livelocks(c: &Controller, p: &Plan, an: &PlanAnalysis, sink: &mut Sink) {
+pub(crate) fn check_livelocks(
+    ir: &Ir,
+    c: &Controller,
+    p: &Plan,
+    an: &PlanAnalysis,
+    sink: &mut Sink,
+) {
     let verb = &c.plan_title(p);
     for found in livelocks(c, p, an) {
         let Some(&(first, first_state)) = found.cycle.first() else {
@@ -69,28 +75,25 @@ pub(crate) fn check_livelocks(c: &Controller, p: &Plan, an: &PlanAnalysis, sink:
                 state_name(p, t_state)
             ),
         );
-        // The run: the way to the ring, then three times round it.
-        let rows: Vec<Firing> = found
-            .cycle
-            .iter()
-            .filter_map(|&(r, _)| match p.rows[r].to {
-                Target::State(to) => Some(Firing {
-                    row: run::row_name(&p.rows[r]),
-                    state: state_name(p, to).to_string(),
-                }),
-                _ => None,
-            })
-            .collect();
-        let cycles = 3 * rows.len() as u32;
-        let run = (rows.len() == found.cycle.len())
-            .then(|| {
-                let expect = Expect::Repeats { rows };
-                an.finding_run(&found.params, first_state, &found.held, cycles, expect)
-            })
-            .flatten();
+        for &x in &found.through {
+            let sub = &ir.controller(x).name;
+            d = d.with_note(format!(
+                "`{sub}` is commanded again on every round, and on the cycle after each \
+                 command it shows EXECUTING (it runs at most once between two cycles of `{}`, \
+                 and its plan cannot answer on a command's first cycle): the ring never waits \
+                 for its answer",
+                c.name
+            ));
+        }
+        if found.path.is_empty() {
+            d = d.with_note(
+                "the vars these states read keep the values the way here leaves them: no row \
+                 of the ring, nor `pre` or `post`, assigns one",
+            );
+        }
         let d = d
             .with_witness(state_name(p, first_state), &found.shown)
-            .with_run(run)
+            .with_run(found.run)
             .with_note(format!(
                 "with these inputs held, one row fires per cycle, round and round: {}; \
                  no other row of these states ever fires, a timeout included",

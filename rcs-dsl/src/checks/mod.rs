@@ -270,7 +270,7 @@ fn check_plan(
     graph::check_dead_ends(c, p, analysis, sink);
     graph::check_no_done(ir, c, p, analysis, sink);
     hang::check_incomplete_states(c, p, conditions, analysis, sink);
-    loops::check_livelocks(c, p, conditions, sink);
+    loops::check_livelocks(ir, c, p, conditions, sink);
     loops::check_command_storms(ir, c, p, conditions, sink);
     index::check_index_range(ir, c, p, conditions, out_of_range, sink);
 }

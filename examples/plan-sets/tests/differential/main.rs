@@ -96,7 +96,9 @@ const NEVER_FIRE: &[(&str, &str, &str, u32, &str)] = &[
     (OK_0132, "B", "RUN", 1, "`state_cycles > 20`: row 2 (`plan_cycles > 3`) ends RUN first"),
     (OK_0133, "A", "GO", 4, "`otherwise`: `x < 0`, `x > 0` and `x == 0` cover every integer"),
     (OK_0137, "A", "GO", 3, "`plan_cycles > 60`: `reading() > limit` or `reading() <= limit` always matches first"),
+    (OK_1209, "Feeder", "FEED", 5, "`S2 when !s.ready -> S1`: the entry sets `armed` and nothing clears it, so row 4 (`S2 when armed`) always fires first — the trap the case is about"),
 ];
+const OK_1209: &str = "tests/data/ok/1209_livelock_var_row_leaves_ring.rcs";
 const OK_0114: &str = "tests/data/ok/0114_analysis_opaque_products.rcs";
 const OK_0115: &str = "tests/data/ok/0115_analysis_hooks_with_different_arguments.rcs";
 const OK_0121: &str = "tests/data/ok/0121_analysis_two_inputs_compared.rcs";

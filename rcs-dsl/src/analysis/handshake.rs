@@ -32,15 +32,7 @@ impl PlanAnalysis<'_> {
         if !matches!(self.prove(&some_row, &fixed), Outcome::None) {
             return None;
         }
-        let none = Formula::Not(Box::new(some_row));
-        let candidates = self.candidates();
-        match Search::new(&self.terms, Mode::Witness, candidates, &[], &fixed)
-            .in_order(self.indexed)
-            .run(&none)
-        {
-            Outcome::Found(values) => Some(self.witness(&none, state, values)),
-            Outcome::None | Outcome::Unknown => None,
-        }
+        self.no_row_witness(state, &some_row, &fixed)
     }
 
     /// A weaker stall than [`stalls_in`](Self::stalls_in): inputs the
@@ -59,16 +51,8 @@ impl PlanAnalysis<'_> {
         alive: bool,
     ) -> Option<Witness> {
         let (some_row, fixed) = self.stall_question(state, sub, status, alive)?;
-        let none = Formula::Not(Box::new(some_row.clone()));
-        let values = match Search::new(&self.terms, Mode::Witness, self.candidates(), &[], &fixed)
-            .in_order(self.indexed)
-            .run(&none)
-        {
-            Outcome::Found(values) => values,
-            Outcome::None | Outcome::Unknown => return None,
-        };
-        let w = self.witness(&none, state, values);
-        let mut held = fixed.clone();
+        let w = self.no_row_witness(state, &some_row, &fixed)?;
+        let mut held = fixed;
         for (l, v) in &w.inputs {
             let holds = matches!(
                 l,
@@ -81,6 +65,24 @@ impl PlanAnalysis<'_> {
             }
         }
         matches!(self.prove(&some_row, &held), Outcome::None).then_some(w)
+    }
+
+    /// A cycle's inputs, with `fixed`, on which no row of `state` matches
+    /// (`some_row` false): the witness of a stall.
+    fn no_row_witness(
+        &self,
+        state: StateId,
+        some_row: &Formula,
+        fixed: &[(LeafId, Value)],
+    ) -> Option<Witness> {
+        let none = Formula::Not(Box::new(some_row.clone()));
+        match Search::new(&self.terms, Mode::Witness, self.candidates(), &[], fixed)
+            .in_order(self.indexed)
+            .run(&none)
+        {
+            Outcome::Found(values) => Some(self.witness(&none, state, values)),
+            Outcome::None | Outcome::Unknown => None,
+        }
     }
 
     /// What a stall in `state` asks: "some row of the state matches", and

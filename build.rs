@@ -123,7 +123,9 @@ fn from_workspace<'w>(workspace: Option<&'w DocumentMut>, section: &str, key: &s
         .and_then(|ws| ws.get("workspace"))
         .and_then(|ws| ws.get(section))
         .and_then(|s| s.get(key))
-        .unwrap_or_else(|| panic!("rcs-runtime inherits `{key}`, which [workspace.{section}] lacks"))
+        .unwrap_or_else(|| {
+            panic!("rcs-runtime inherits `{key}`, which [workspace.{section}] lacks")
+        })
 }
 
 /// The runtime's manifest as a crate of its own: `[package]`'s identity,
@@ -177,7 +179,11 @@ fn standalone_manifest(manifest: &DocumentMut, workspace: Option<&DocumentMut>) 
         .expect("rcs-runtime/Cargo.toml has [dependencies]");
     for (name, item) in dependencies.iter() {
         let table = item.as_table_like();
-        if table.and_then(|t| t.get("optional")).and_then(Item::as_bool) == Some(true) {
+        if table
+            .and_then(|t| t.get("optional"))
+            .and_then(Item::as_bool)
+            == Some(true)
+        {
             dropped_deps.push(name.to_string());
             continue;
         }

@@ -46,9 +46,30 @@ fn outside_the_workspace(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("rcsc-{name}-{:016x}", hasher.finish()))
 }
 
+/// Cargo as a user runs it: without what `cargo test` set for this test
+/// process. `OUT_DIR` above all: rustc reads `env!` from the environment
+/// cargo passes on, so an inherited `OUT_DIR` would let a package whose
+/// build script is missing compile against this checkout's build output.
 fn cargo() -> Command {
     let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
-    cargo.env_remove("CARGO_TARGET_DIR");
+    for (name, _) in std::env::vars_os() {
+        let name = name.to_string_lossy();
+        let set_by_cargo_test = name == "OUT_DIR"
+            || name == "CARGO_TARGET_DIR"
+            || name == "CARGO_TARGET_TMPDIR"
+            || name == "CARGO_PRIMARY_PACKAGE"
+            || [
+                "CARGO_PKG_",
+                "CARGO_MANIFEST_",
+                "CARGO_CRATE_",
+                "CARGO_BIN_",
+            ]
+            .iter()
+            .any(|prefix| name.starts_with(prefix));
+        if set_by_cargo_test {
+            cargo.env_remove(&*name);
+        }
+    }
     cargo
 }
 
@@ -127,6 +148,14 @@ fn check_package_contents() {
             assert!(
                 files.iter().any(|f| f == needed),
                 "{package} lacks {needed}: {files:?}"
+            );
+        }
+        // Cargo leaves out a build script `include` misses with only a
+        // warning: rcsc's embeds the runtime, the runtime's names its folder.
+        if package == "rcsc" || package == "rcs-runtime" {
+            assert!(
+                files.iter().any(|f| f == "build.rs"),
+                "{package} lacks build.rs: {files:?}"
             );
         }
         for file in &files {
@@ -224,6 +253,7 @@ fn rcsc_test(rcsc: &Path, cwd: &Path, args: &[&str]) -> Output {
         .env("CARGO_NET_OFFLINE", "true")
         .env_remove("CARGO")
         .env_remove("CARGO_TARGET_DIR")
+        .env_remove("OUT_DIR")
         .env_remove("RCSC_RUNTIME_PATH")
         .output()
         .expect("rcsc runs")

@@ -1,21 +1,32 @@
 //! Ships `rcs-runtime` inside `rcsc`: `rcsc test --backend compiled` builds
 //! the generated code against the runtime, and an installed `rcsc` has no
 //! source tree to point cargo at. This writes `$OUT_DIR/runtime.rs` with
-//! every file below `rcs-runtime/src` (`include_str!`, so cargo tracks each
-//! one) and a standalone manifest made from `rcs-runtime/Cargo.toml`: its
-//! `workspace = true` keys replaced by the workspace's values, and what only
-//! the workspace builds (dev-dependencies, benches) left out. Generated on
-//! every build, the copy cannot drift from the real crate.
+//! every file below the runtime's `src/` (`include_str!`, so cargo tracks
+//! each one) and a standalone manifest made from the runtime's
+//! `Cargo.toml`: its `workspace = true` keys replaced by the workspace's
+//! values, and what only the workspace builds (dev-dependencies, benches,
+//! the optional Zenoh bridge) left out. Generated on every build, the copy
+//! cannot drift from the real crate.
+//!
+//! The runtime's folder comes from the runtime itself (`DEP_RCS_RUNTIME_ROOT`,
+//! set by its `links` build script), not from a path beside this file: in
+//! the repository it is `rcs-runtime/`, but the published rcsc package holds
+//! only rcsc (cargo leaves a nested package's folder out of a package), and
+//! `cargo install rcsc` builds it against the rcs-runtime crate cargo
+//! unpacked — whose manifest is the normalized one `cargo publish` writes.
+//! Both manifest forms are read with a real TOML parser.
 
-use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use toml_edit::{DocumentMut, Item, Value};
 
 fn main() {
-    let root = PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").expect("set by cargo"));
-    let runtime = root.join("rcs-runtime");
-    for watched in ["rcs-runtime/src", "rcs-runtime/Cargo.toml", "Cargo.toml"] {
-        println!("cargo:rerun-if-changed={watched}");
+    let runtime = PathBuf::from(std::env::var_os("DEP_RCS_RUNTIME_ROOT").expect(
+        "rcs-runtime's build script names its folder (`links = \"rcs_runtime\"` in its manifest)",
+    ));
+    let manifest_path = runtime.join("Cargo.toml");
+    for watched in [runtime.join("src"), manifest_path.clone()] {
+        println!("cargo::rerun-if-changed={}", watched.display());
     }
 
     let mut files = Vec::new();
@@ -31,12 +42,25 @@ fn main() {
         writeln!(out, "    ({relative:?}, include_str!({absolute:?})),").unwrap();
     }
     out.push_str("];\n\n");
-    let workspace = read(&root.join("Cargo.toml"));
-    let manifest = standalone_manifest(&read(&runtime.join("Cargo.toml")), &workspace);
+
+    let manifest = parse(&manifest_path);
+    // Inheritance only in the repository's form; then the workspace root is
+    // the nearest folder above with a `[workspace]` table.
+    let workspace = uses_workspace(&manifest).then(|| {
+        let root = runtime
+            .ancestors()
+            .skip(1)
+            .map(|dir| dir.join("Cargo.toml"))
+            .find(|candidate| candidate.is_file() && parse(candidate).contains_key("workspace"))
+            .expect("rcs-runtime inherits from a workspace, but none is above it");
+        println!("cargo::rerun-if-changed={}", root.display());
+        parse(&root)
+    });
+    let standalone = standalone_manifest(&manifest, workspace.as_ref());
     writeln!(
         out,
         "/// `rcs-runtime/Cargo.toml` without workspace inheritance.\n\
-         pub const RUNTIME_MANIFEST: &str = {manifest:?};"
+         pub const RUNTIME_MANIFEST: &str = {standalone:?};"
     )
     .unwrap();
 
@@ -44,8 +68,11 @@ fn main() {
     std::fs::write(out_dir.join("runtime.rs"), out).expect("write $OUT_DIR/runtime.rs");
 }
 
-fn read(path: &Path) -> String {
-    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))
+fn parse(path: &Path) -> DocumentMut {
+    let text = std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    text.parse()
+        .unwrap_or_else(|e| panic!("{} is not TOML: {e}", path.display()))
 }
 
 fn collect(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -60,106 +87,158 @@ fn collect(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// `key = value` lines of each `[section]` of a TOML file (one-line values:
-/// what the project's manifests use).
-fn sections(toml: &str) -> BTreeMap<String, BTreeMap<String, String>> {
-    let mut all: BTreeMap<String, BTreeMap<String, String>> = BTreeMap::new();
-    let mut section = String::new();
-    for line in toml.lines().map(str::trim) {
-        if line.starts_with('[') {
-            section = line.trim_matches(|c| c == '[' || c == ']').to_string();
-        } else if let Some((key, value)) = line.split_once('=') {
-            if !line.starts_with('#') {
-                all.entry(section.clone())
-                    .or_default()
-                    .insert(key.trim().to_string(), value.trim().to_string());
-            }
-        }
-    }
-    all
+/// `{ workspace = true }` (or `key.workspace = true`), an inherited value.
+fn inherits(item: &Item) -> bool {
+    item.as_table_like()
+        .and_then(|t| t.get("workspace"))
+        .and_then(Item::as_bool)
+        == Some(true)
 }
 
-/// The runtime's manifest with every `workspace = true` resolved. Keeps
-/// `[package]`, `[dependencies]` and `[features]`, less the optional
-/// dependencies (the Zenoh bridge's) and the features that only turn them
-/// on, which the one-process compiled backend never uses; stops the build on a form
-/// it does not know rather than ship a manifest cargo would read otherwise.
-fn standalone_manifest(manifest: &str, workspace: &str) -> String {
-    let ws = sections(workspace);
-    let lookup = |section: &str, key: &str| -> String {
-        ws.get(section)
-            .and_then(|s| s.get(key))
-            .unwrap_or_else(|| panic!("rcs-runtime inherits `{key}`, which [{section}] lacks"))
-            .clone()
-    };
-    let mut out = String::new();
-    let mut keep = false;
-    let mut section = String::new();
+fn uses_workspace(manifest: &DocumentMut) -> bool {
+    ["package", "dependencies"].iter().any(|section| {
+        manifest
+            .get(section)
+            .and_then(Item::as_table_like)
+            .is_some_and(|t| t.iter().any(|(_, item)| inherits(item)))
+    })
+}
+
+/// One TOML value on one line, without the decoration it had in its file.
+fn inline(item: &Item, what: &str) -> Value {
+    let mut value = item
+        .clone()
+        .into_value()
+        .unwrap_or_else(|_| panic!("rcs-runtime/Cargo.toml: `{what}` is not a value"));
+    if let Some(table) = value.as_inline_table_mut() {
+        table.fmt();
+    }
+    value.decor_mut().clear();
+    value
+}
+
+/// `[section] key` of the workspace manifest, for an inherited key.
+fn from_workspace<'w>(workspace: Option<&'w DocumentMut>, section: &str, key: &str) -> &'w Item {
+    workspace
+        .and_then(|ws| ws.get("workspace"))
+        .and_then(|ws| ws.get(section))
+        .and_then(|s| s.get(key))
+        .unwrap_or_else(|| {
+            panic!("rcs-runtime inherits `{key}`, which [workspace.{section}] lacks")
+        })
+}
+
+/// The runtime's manifest as a crate of its own: `[package]`'s identity,
+/// the non-optional `[dependencies]` and the `[features]` that do not only
+/// turn on an optional one (the Zenoh bridge's: the compiled backend runs
+/// one process). Stops the build on a form it does not know rather than
+/// ship a manifest cargo would read otherwise.
+fn standalone_manifest(manifest: &DocumentMut, workspace: Option<&DocumentMut>) -> String {
+    for (section, _) in manifest.iter() {
+        assert!(
+            matches!(
+                section,
+                "package"
+                    | "dependencies"
+                    | "features"
+                    | "dev-dependencies"
+                    | "lib"
+                    | "bench"
+                    | "example"
+                    | "test"
+                    | "lints"
+                    | "badges"
+            ),
+            "rcs-runtime/Cargo.toml: build.rs does not know what to do with [{section}]"
+        );
+    }
+    let mut out = String::from("[package]\n");
+    let package = manifest["package"]
+        .as_table_like()
+        .expect("rcs-runtime/Cargo.toml has [package]");
+    // Identity only: `links` and `build` belong to the real crate's build
+    // script, which the shipped copy does not carry; `readme`, `include`
+    // and the registry metadata name files it does not carry either.
+    for key in ["name", "version", "edition", "rust-version", "license"] {
+        let Some(item) = package.get(key) else {
+            continue;
+        };
+        let item = if inherits(item) {
+            from_workspace(workspace, "package", key)
+        } else {
+            item
+        };
+        writeln!(out, "{key} = {}", inline(item, key)).unwrap();
+    }
+
+    out.push_str("\n[dependencies]\n");
     let mut dropped_deps: Vec<String> = Vec::new();
-    let mut dropped_features: Vec<String> = Vec::new();
-    for line in manifest.lines() {
-        let trimmed = line.trim();
-        if trimmed.starts_with('[') {
-            section = trimmed.trim_matches(|c| c == '[' || c == ']').to_string();
-            keep = matches!(section.as_str(), "package" | "dependencies" | "features");
+    let dependencies = manifest
+        .get("dependencies")
+        .and_then(Item::as_table_like)
+        .expect("rcs-runtime/Cargo.toml has [dependencies]");
+    for (name, item) in dependencies.iter() {
+        let table = item.as_table_like();
+        if table
+            .and_then(|t| t.get("optional"))
+            .and_then(Item::as_bool)
+            == Some(true)
+        {
+            dropped_deps.push(name.to_string());
+            continue;
+        }
+        let mut value = if inherits(item) {
+            let extra: Vec<&str> = table.unwrap().iter().map(|(k, _)| k).collect();
             assert!(
-                keep || matches!(section.as_str(), "dev-dependencies" | "bench" | "example"),
-                "rcs-runtime/Cargo.toml: build.rs does not know what to do with [{section}]"
+                extra.iter().all(|k| *k == "workspace"),
+                "rcs-runtime/Cargo.toml: `{name}`: only a plain `{{ workspace = true }}` is resolved, not {extra:?}"
             );
-            if keep {
-                out.push('\n');
-                out.push_str(trimmed);
-                out.push('\n');
+            inline(from_workspace(workspace, "dependencies", name), name)
+        } else {
+            inline(item, name)
+        };
+        if let Some(table) = value.as_inline_table_mut() {
+            assert!(
+                !table.contains_key("path") && !table.contains_key("git"),
+                "rcs-runtime/Cargo.toml: `{name}` is not from the registry; the shipped copy cannot carry it"
+            );
+            // `{ version = "2" }`, as the normalized manifest writes it,
+            // is `"2"`.
+            if table.len() == 1 {
+                if let Some(version) = table.get("version") {
+                    value = version.clone();
+                    value.decor_mut().clear();
+                }
             }
-            continue;
         }
-        if !keep || trimmed.is_empty() || trimmed.starts_with('#') {
-            continue;
-        }
-        let (key, value) = trimmed.split_once('=').expect("a `key = value` line");
-        let (key, value) = (key.trim(), value.trim());
-        // The shipped copy runs one process: no optional dependency (the
-        // Zenoh bridge's), and no feature that only turns them on.
-        if section == "dependencies" && value.replace(' ', "").contains("optional=true") {
-            dropped_deps.push(key.to_string());
-            continue;
-        }
-        if section == "features" {
-            let needs_dropped = value
-                .trim_matches(|c| c == '[' || c == ']')
-                .split(',')
-                .map(|d| d.trim().trim_matches('"'))
-                .filter(|d| !d.is_empty())
-                .all(|d| {
+        writeln!(out, "{name} = {value}").unwrap();
+    }
+
+    let mut dropped_features: Vec<String> = Vec::new();
+    let mut features = String::new();
+    if let Some(table) = manifest.get("features").and_then(Item::as_table_like) {
+        for (name, item) in table.iter() {
+            let enables: Vec<&str> = item
+                .as_array()
+                .expect("a feature is an array")
+                .iter()
+                .filter_map(Value::as_str)
+                .collect();
+            let needs_dropped = !enables.is_empty()
+                && enables.iter().all(|d| {
                     d.strip_prefix("dep:")
                         .is_some_and(|n| dropped_deps.iter().any(|x| x == n))
                 });
             if needs_dropped {
-                dropped_features.push(key.to_string());
-                continue;
+                dropped_features.push(name.to_string());
+            } else {
+                writeln!(features, "{name} = {}", inline(item, name)).unwrap();
             }
         }
-        let resolved = if let Some(name) = key.strip_suffix(".workspace") {
-            assert_eq!(value, "true", "{trimmed}");
-            let from = if section == "package" {
-                "workspace.package"
-            } else {
-                "workspace.dependencies"
-            };
-            format!("{name} = {}", lookup(from, name))
-        } else if value.contains("workspace") {
-            let compact: String = value.chars().filter(|c| !c.is_whitespace()).collect();
-            assert_eq!(
-                compact, "{workspace=true}",
-                "rcs-runtime/Cargo.toml: `{trimmed}`: only a plain `{{ workspace = true }}` is resolved"
-            );
-            assert_eq!(section, "dependencies", "{trimmed}");
-            format!("{key} = {}", lookup("workspace.dependencies", key))
-        } else {
-            trimmed.to_string()
-        };
-        out.push_str(&resolved);
-        out.push('\n');
+    }
+    if !features.is_empty() {
+        out.push_str("\n[features]\n");
+        out.push_str(&features);
     }
     if !dropped_features.is_empty() {
         // The sources still say `#[cfg(feature = "zenoh")]`: a known name,
@@ -170,5 +249,5 @@ fn standalone_manifest(manifest: &str, workspace: &str) -> String {
             names.join(", ")
         ));
     }
-    out.trim_start().to_string()
+    out
 }

@@ -1,14 +1,23 @@
-//! An installed `rcsc` needs no checkout: `cargo install` from a copy of
-//! this repository into a temporary root, delete the copy, then run the
-//! compiled backend on a plan set in another folder, offline.
+//! An installed `rcsc` needs no checkout, and installs from what cargo
+//! publishes: package the published crates (`cargo package`, the `.crate`
+//! files `cargo publish` would upload), check what each holds, unpack them
+//! into a folder of their own, `cargo install` rcsc from the unpacked
+//! package into a temporary root with the unpacked rcs-dsl, rcs-codegen and
+//! rcs-runtime patched in for crates.io (where they are not yet), delete
+//! the unpacked crates, then run the compiled backend on a plan set in
+//! another folder, offline. No file of the checkout takes part but through
+//! a `.crate`: a package that leaves out something rcsc needs fails here.
 //!
-//! Needs `git` (to list the repository's files) and cargo with rcsc's
+//! Slow (the one `cargo install` of the suite builds rcsc and its
+//! dependencies from scratch on a first run, minutes) but not ignored: the
+//! README's test command and CI run it. Needs cargo with rcsc's
 //! dependencies in its registry cache (true once rcsc has been built, which
-//! running this test implies). The copy is made at one path under cargo's
-//! target folder, with the files' times kept, and the install builds into a
-//! folder there kept between runs (`installed-build`), so a second run
-//! rebuilds only what changed; the driver builds into `installed-drivers`,
-//! also kept.
+//! running this test implies) and `tar` (to unpack a `.crate`, as cargo
+//! does). The unpacked crates sit at one path per checkout in the
+//! temporary folder, and the install builds into a folder under cargo's
+//! target folder kept between runs
+//! (`installed-build`), so a second run rebuilds only what changed; the
+//! driver builds into `installed-drivers`, also kept.
 
 #[allow(dead_code)] // not every helper is used here
 mod common;
@@ -27,43 +36,197 @@ fn kept(name: &str) -> PathBuf {
     Path::new(env!("CARGO_TARGET_TMPDIR")).join(name)
 }
 
-fn cargo() -> Command {
-    Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
+/// A folder of this checkout's own outside its workspace (a package below
+/// the workspace root would be taken for an unlisted member), at one path
+/// for this checkout, kept between test runs.
+fn outside_the_workspace(name: &str) -> PathBuf {
+    use std::hash::{Hash, Hasher};
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    repo().hash(&mut hasher);
+    std::env::temp_dir().join(format!("rcsc-{name}-{:016x}", hasher.finish()))
 }
 
-/// The repository as a person's checkout holds it: the files git tracks and
-/// the new ones it does not ignore, as they are in the working tree.
-fn copy_checkout(to: &Path) {
-    let listed = Command::new("git")
+/// Cargo as a user runs it: without what `cargo test` set for this test
+/// process. `OUT_DIR` above all: rustc reads `env!` from the environment
+/// cargo passes on, so an inherited `OUT_DIR` would let a package whose
+/// build script is missing compile against this checkout's build output.
+fn cargo() -> Command {
+    let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
+    for (name, _) in std::env::vars_os() {
+        let name = name.to_string_lossy();
+        let set_by_cargo_test = name == "OUT_DIR"
+            || name == "CARGO_TARGET_DIR"
+            || name == "CARGO_TARGET_TMPDIR"
+            || name == "CARGO_PRIMARY_PACKAGE"
+            || [
+                "CARGO_PKG_",
+                "CARGO_MANIFEST_",
+                "CARGO_CRATE_",
+                "CARGO_BIN_",
+            ]
+            .iter()
+            .any(|prefix| name.starts_with(prefix));
+        if set_by_cargo_test {
+            cargo.env_remove(&*name);
+        }
+    }
+    cargo
+}
+
+/// The crates `cargo publish --workspace` uploads, in dependency order.
+const PUBLISHED: [&str; 4] = ["rcs-runtime", "rcs-dsl", "rcs-codegen", "rcsc"];
+
+/// The workspace's members with `publish` unset: the published ones.
+fn publishable_members() -> Vec<String> {
+    let out = cargo()
         .args([
-            "ls-files",
-            "-z",
-            "--cached",
-            "--others",
-            "--exclude-standard",
+            "metadata",
+            "--offline",
+            "--no-deps",
+            "--format-version",
+            "1",
         ])
         .current_dir(repo())
         .output()
-        .expect("git runs (this test needs git on PATH)");
-    assert!(listed.status.success(), "{}", text(&listed.stderr));
-    for path in listed.stdout.split(|&b| b == 0).filter(|p| !p.is_empty()) {
-        let path = std::str::from_utf8(path).expect("a UTF-8 path");
-        let from = repo().join(path);
-        if !from.is_file() {
-            continue; // deleted in the working tree
+        .expect("cargo runs");
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let metadata: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let mut names: Vec<String> = metadata["packages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|p| p["publish"].is_null())
+        .map(|p| p["name"].as_str().unwrap().to_string())
+        .collect();
+    names.sort();
+    names
+}
+
+/// `cargo package --list` of `package`: what its `.crate` holds.
+fn package_list(package: &str) -> Vec<String> {
+    let out = cargo()
+        .args([
+            "package",
+            "--list",
+            "--offline",
+            "--allow-dirty",
+            "-p",
+            package,
+        ])
+        .current_dir(repo())
+        .output()
+        .expect("cargo runs");
+    assert!(out.status.success(), "{package}: {}", text(&out.stderr));
+    text(&out.stdout).lines().map(str::to_string).collect()
+}
+
+/// Each published package holds its sources, manifest, readme and both
+/// licenses, and none of the repository's test corpora, build output,
+/// criterion results, snapshots, benches or plan sets.
+fn check_package_contents() {
+    let mut expected: Vec<String> = PUBLISHED.iter().map(|s| s.to_string()).collect();
+    expected.sort();
+    assert_eq!(
+        publishable_members(),
+        expected,
+        "every other workspace member has `publish = false`"
+    );
+    for package in PUBLISHED {
+        let files = package_list(package);
+        for needed in [
+            "Cargo.toml",
+            "README.md",
+            "LICENSE-MIT",
+            "LICENSE-APACHE",
+            "src/lib.rs",
+        ] {
+            let needed = if package == "rcsc" && needed == "src/lib.rs" {
+                "src/main.rs"
+            } else {
+                needed
+            };
+            assert!(
+                files.iter().any(|f| f == needed),
+                "{package} lacks {needed}: {files:?}"
+            );
         }
-        let into = to.join(path);
-        std::fs::create_dir_all(into.parent().unwrap()).unwrap();
-        std::fs::copy(&from, &into).unwrap();
-        // Keep the file's time, as `cp -p` does: at the same kept path, cargo
-        // then rebuilds only what changed since the last run.
-        let modified = std::fs::metadata(&from).unwrap().modified().unwrap();
-        std::fs::File::options()
-            .write(true)
-            .open(&into)
-            .and_then(|f| f.set_modified(modified))
-            .unwrap();
+        // Cargo leaves out a build script `include` misses with only a
+        // warning: rcsc's embeds the runtime, the runtime's names its folder.
+        if package == "rcsc" || package == "rcs-runtime" {
+            assert!(
+                files.iter().any(|f| f == "build.rs"),
+                "{package} lacks build.rs: {files:?}"
+            );
+        }
+        for file in &files {
+            let unwanted = [
+                "tests/",
+                "target/",
+                "benches/",
+                "examples/",
+                "plans/",
+                "rcs-runtime/",
+            ]
+            .iter()
+            .any(|folder| file.starts_with(folder))
+                || file.contains("criterion")
+                || file.ends_with(".snap");
+            assert!(!unwanted, "{package}'s package holds {file}");
+        }
     }
+    // The licenses in each package folder are the root's, word for word.
+    for package in ["rcs-runtime", "rcs-dsl", "rcs-codegen"] {
+        for license in ["LICENSE-MIT", "LICENSE-APACHE"] {
+            assert_eq!(
+                std::fs::read_to_string(repo().join(package).join(license)).unwrap(),
+                std::fs::read_to_string(repo().join(license)).unwrap(),
+                "{package}/{license} is a copy of the root's"
+            );
+        }
+    }
+}
+
+/// The published crates as `cargo package` writes them (no verification
+/// build: installing rcsc from them below is the verification), unpacked
+/// into `into/<name>-<version>/`. Returns those folders by crate name.
+fn package_and_unpack(into: &Path) -> Vec<(&'static str, PathBuf)> {
+    let target = into.join("package-target");
+    let mut package = cargo();
+    package.args(["package", "--offline", "--no-verify", "--allow-dirty"]);
+    for name in PUBLISHED {
+        package.args(["-p", name]);
+    }
+    let out = package
+        .arg("--target-dir")
+        .arg(&target)
+        .current_dir(repo())
+        .output()
+        .expect("cargo runs");
+    assert!(
+        out.status.success(),
+        "cargo package failed:\n{}",
+        text(&out.stderr)
+    );
+    let version = env!("CARGO_PKG_VERSION");
+    let unpacked = PUBLISHED
+        .iter()
+        .map(|name| {
+            let file = target
+                .join("package")
+                .join(format!("{name}-{version}.crate"));
+            let untar = Command::new("tar")
+                .arg("xzf")
+                .arg(&file)
+                .arg("-C")
+                .arg(into)
+                .output()
+                .expect("tar runs (this test needs tar on PATH)");
+            assert!(untar.status.success(), "{}", text(&untar.stderr));
+            (*name, into.join(format!("{name}-{version}")))
+        })
+        .collect();
+    std::fs::remove_dir_all(&target).unwrap();
+    unpacked
 }
 
 fn copy_dir(from: &Path, to: &Path) {
@@ -90,33 +253,49 @@ fn rcsc_test(rcsc: &Path, cwd: &Path, args: &[&str]) -> Output {
         .env("CARGO_NET_OFFLINE", "true")
         .env_remove("CARGO")
         .env_remove("CARGO_TARGET_DIR")
+        .env_remove("OUT_DIR")
         .env_remove("RCSC_RUNTIME_PATH")
         .output()
         .expect("rcsc runs")
 }
 
 #[test]
-fn an_installed_rcsc_runs_the_compiled_backend_without_its_checkout() {
+fn rcsc_installed_from_its_packages_runs_the_compiled_backend() {
+    check_package_contents();
     let tmp = scratch("installed", &[]);
-    // The copy lives at one path kept between runs (and is deleted after
-    // the install, as the test requires): cargo keys its build of a path
-    // package on that path, so a second run reuses the first's.
-    let source = kept("installed-checkout");
-    let _ = std::fs::remove_dir_all(&source);
+    // The unpacked crates live at one path kept between runs (and are
+    // deleted after the install): cargo keys its build of a path package
+    // on that path, so a second run reuses the first's.
+    let crates = outside_the_workspace("installed-crates");
+    let _ = std::fs::remove_dir_all(&crates);
+    std::fs::create_dir_all(&crates).unwrap();
+    let unpacked = package_and_unpack(&crates);
+    // What a registry would serve, by `[patch.crates-io]`: cargo install
+    // reads no configuration from the current folder, so it comes by
+    // `--config FILE`.
+    let mut patch = String::from("[patch.crates-io]\n");
+    for (name, dir) in &unpacked[..3] {
+        let dir = dir.to_str().unwrap().replace('\\', "/");
+        patch.push_str(&format!("{name} = {{ path = {dir:?} }}\n"));
+    }
+    let config = tmp.join("patch.toml");
+    std::fs::write(&config, patch).unwrap();
+    let (_, rcsc_package) = &unpacked[3];
     let root = tmp.join("root");
-    copy_checkout(&source);
 
     let started = Instant::now();
     let install = cargo()
         .args(["install", "--locked", "--offline", "--debug", "--quiet"])
+        .arg("--config")
+        .arg(&config)
         .arg("--path")
-        .arg(&source)
+        .arg(rcsc_package)
         .arg("--root")
         .arg(&root)
         .arg("--target-dir")
         .arg(kept("installed-build"))
-        .env_remove("CARGO_TARGET_DIR")
         .env_remove("CARGO_INSTALL_ROOT")
+        .current_dir(&tmp)
         .output()
         .expect("cargo runs");
     assert!(
@@ -125,8 +304,8 @@ fn an_installed_rcsc_runs_the_compiled_backend_without_its_checkout() {
         text(&install.stderr)
     );
     eprintln!("cargo install: {:.1?}", started.elapsed());
-    std::fs::remove_dir_all(&source).unwrap();
-    assert!(!source.exists());
+    std::fs::remove_dir_all(&crates).unwrap();
+    assert!(!crates.exists());
 
     // A plan set with its scenarios, alone in another folder.
     let work = tmp.join("work");

@@ -193,6 +193,9 @@ impl Code {
             Code::Lint(Lint::UnreachableState) => "no path from the entry reaches a state",
             Code::Lint(Lint::DeadEndState) => "a state has no way out",
             Code::Lint(Lint::NoDone) => "a plan never reaches `Done` or `Error`",
+            Code::Lint(Lint::StateTypo) => {
+                "a state named once is one edit from another state, `Done`, `Error` or `same`: a typo"
+            }
             Code::Lint(Lint::SpanOfControl) => "a supervisor has too many subordinates",
             Code::Lint(Lint::LevelOrder) => "a subordinate's level is not below its supervisor's",
             Code::Lint(Lint::FloatEquality) => "floats compared with `==` or `!=`",

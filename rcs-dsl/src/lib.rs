@@ -46,6 +46,7 @@ pub mod pretty;
 pub mod render;
 pub mod scenario;
 pub mod source;
+pub mod suggest;
 pub mod time;
 pub mod watchdog;
 pub mod yaml;

@@ -335,7 +335,8 @@ impl Cx<'_, '_> {
                                 p.span,
                                 "no such parameter",
                             )
-                            .with_help(have),
+                            .with_help(have)
+                            .suggest(&p.text, command.params.iter().map(|p| p.name.as_str())),
                         );
                         (err_expr(span), Ty::Err)
                     }

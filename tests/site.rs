@@ -1,7 +1,7 @@
 //! `rcsc doc`, `rcsc trace` and traces, end to end: the pages of a small
 //! plan set (snapshots of the pure generation), every link of the site
 //! for `plans/` resolving, byte-identical output, the site without
-//! Graphviz, trace versions, a run of the submarine example replayed
+//! Graphviz, `--open` without a browser, trace versions, a run of the submarine example replayed
 //! through `rcsc trace`, a large set documented cluster by cluster, and
 //! the Changes page of `rcsc doc --diff` (fixture: `tests/data/site/`).
 
@@ -168,6 +168,58 @@ fn without_graphviz_the_site_has_notices_instead_of_drawings() {
     assert!(files["PR.AHEAD.html"].contains("class=\"notice\""));
     assert!(!files["PR.AHEAD.html"].contains("<svg"));
     assert_eq!(broken_links(&files), Vec::<String>::new());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn doc_open_without_a_browser_names_the_page_in_one_line() {
+    let dir = scratch("doc-nobrowser", &[]);
+    let out = dir.join("site");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rcsc"))
+        .args([
+            "doc",
+            "plans/figure13",
+            "-q",
+            "--open",
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .env("PATH", &dir) // an empty folder: no `xdg-open`, no `dot`
+        .env_remove("BROWSER")
+        .env("NO_COLOR", "1")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    let index = out.join("index.html");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("no browser") && err.contains(index.to_str().unwrap()),
+        "{err}"
+    );
+    assert!(index.is_file());
+    // A `$BROWSER` that fails is named.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rcsc"))
+        .args([
+            "doc",
+            "plans/figure13",
+            "-q",
+            "--open",
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .env("PATH", &dir)
+        .env("BROWSER", dir.join("no-such-browser"))
+        .env("NO_COLOR", "1")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("`$BROWSER`") && err.contains("no-such-browser"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -114,7 +114,7 @@ pub fn key_under_a_value(text: &str, line: usize) -> Option<Misplaced> {
     let has_value = !text[above_end + 1..above_start + above.len()]
         .trim()
         .is_empty();
-    (has_value && indent > above_indent).then(|| Misplaced {
+    (has_value && indent > above_indent).then_some(Misplaced {
         start: s,
         end: e,
         line,

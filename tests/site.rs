@@ -171,27 +171,35 @@ fn without_graphviz_the_site_has_notices_instead_of_drawings() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `rcsc doc plans/figure13 -q --open` into `out`, with no program on the
+/// PATH (an empty folder) and `$BROWSER` as given.
+fn doc_open(out: &Path, empty: &Path, browser: Option<&Path>) -> std::process::Output {
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_rcsc"));
+    cmd.args([
+        "doc",
+        "plans/figure13",
+        "-q",
+        "--open",
+        "-o",
+        out.to_str().unwrap(),
+    ])
+    .env("PATH", empty)
+    .env("NO_COLOR", "1");
+    match browser {
+        Some(b) => cmd.env("BROWSER", b),
+        None => cmd.env_remove("BROWSER"),
+    };
+    cmd.output().unwrap()
+}
+
 #[test]
 fn doc_open_without_a_browser_names_the_page_in_one_line() {
     let dir = scratch("doc-nobrowser", &[]);
     let out = dir.join("site");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rcsc"))
-        .args([
-            "doc",
-            "plans/figure13",
-            "-q",
-            "--open",
-            "-o",
-            out.to_str().unwrap(),
-        ])
-        .env("PATH", &dir) // an empty folder: no `xdg-open`, no `dot`
-        .env_remove("BROWSER")
-        .env("NO_COLOR", "1")
-        .output()
-        .unwrap();
+    let index = out.join("index.html");
+    let o = doc_open(&out, &dir, None);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
     let err = text(&o.stderr);
-    let index = out.join("index.html");
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(
         err.contains("no browser") && err.contains(index.to_str().unwrap()),
@@ -199,20 +207,7 @@ fn doc_open_without_a_browser_names_the_page_in_one_line() {
     );
     assert!(index.is_file());
     // A `$BROWSER` that fails is named.
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rcsc"))
-        .args([
-            "doc",
-            "plans/figure13",
-            "-q",
-            "--open",
-            "-o",
-            out.to_str().unwrap(),
-        ])
-        .env("PATH", &dir)
-        .env("BROWSER", dir.join("no-such-browser"))
-        .env("NO_COLOR", "1")
-        .output()
-        .unwrap();
+    let o = doc_open(&out, &dir, Some(&dir.join("no-such-browser")));
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
     let err = text(&o.stderr);
     assert_eq!(err.lines().count(), 1, "{err}");

@@ -39,7 +39,9 @@ impl PlanSet {
             ),
             (None, _) => {
                 // No file to point into: the folder stands as an empty one.
-                let id = self.sources.add(format!("{here}/"), String::new());
+                let id = self
+                    .sources
+                    .add(format!("{}/", here.trim_end_matches('/')), String::new());
                 (Span::new(id, 0, 0), "no `.rcs` file in this folder")
             }
         };

@@ -250,13 +250,7 @@ impl Cx<'_, '_> {
                         "not a subordinate",
                     )
                     .with_help(help)
-                    .suggest(
-                        &sub.text,
-                        self.c
-                            .subordinates
-                            .iter()
-                            .map(|s| self.ir.controllers[s.index()].name.as_str()),
-                    ),
+                    .suggest(&sub.text, self.subordinate_names()),
                 );
                 None
             }

@@ -448,10 +448,7 @@ impl Cx<'_, '_> {
                         ))
                         .suggest(
                             &x.text,
-                            self.c
-                                .subordinates
-                                .iter()
-                                .map(|s| self.ir.controllers[s.index()].name.as_str()),
+                            self.subordinate_names(),
                         ),
                     );
                     return (err_expr(span), Ty::Err);
@@ -542,13 +539,7 @@ impl Cx<'_, '_> {
                     "not a subordinate",
                 )
                 .with_help(format!("add it to `{}`'s `subordinates` list", self.c.name))
-                .suggest(
-                    &x.text,
-                    self.c
-                        .subordinates
-                        .iter()
-                        .map(|s| self.ir.controllers[s.index()].name.as_str()),
-                )
+                .suggest(&x.text, self.subordinate_names())
             };
             self.diags.push(d);
             return (err_expr(span), Ty::Err);

@@ -337,19 +337,40 @@ fn render_batch(graphs: &[GraphSource]) -> Result<Vec<String>, String> {
     Ok(docs)
 }
 
-/// Open a file in the desktop's browser, if there is one.
+/// Open a file in the desktop's browser, if there is one: `$BROWSER`
+/// first (as `cargo doc --open` does), else the desktop's opener. Without
+/// a browser (a server, a container, no `xdg-open` or none that works),
+/// one line says which file to open; the site is built, so this is no
+/// failure and the exit status stays 0. The opener's own complaints are
+/// not shown: the line says all the user can act on.
 fn open(path: &Path) {
-    let opener = if cfg!(target_os = "macos") {
-        "open"
-    } else if cfg!(windows) {
-        "explorer"
-    } else {
-        "xdg-open"
+    let shown = rcs_dsl::load::display(path);
+    let browser = std::env::var_os("BROWSER").filter(|b| !b.is_empty());
+    let opener = browser.clone().unwrap_or_else(|| {
+        if cfg!(target_os = "macos") {
+            "open".into()
+        } else if cfg!(windows) {
+            "explorer".into()
+        } else {
+            "xdg-open".into()
+        }
+    });
+    let ran = std::process::Command::new(&opener)
+        .arg(path)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .status();
+    // `explorer` exits 1 even when it opened the file.
+    let opened = match ran {
+        Ok(status) => status.success() || (cfg!(windows) && browser.is_none()),
+        Err(_) => false,
     };
-    if let Err(e) = std::process::Command::new(opener).arg(path).status() {
-        eprintln!(
-            "warning: cannot open {} with `{opener}`: {e}",
-            rcs_dsl::load::display(path)
-        );
+    if !opened {
+        let how = match &browser {
+            Some(b) => format!("`$BROWSER` ({}) could not open it", b.to_string_lossy()),
+            None => format!("no browser found (`{}`)", opener.to_string_lossy()),
+        };
+        eprintln!("note: {how}: open {shown} in a browser");
     }
 }

@@ -538,3 +538,24 @@ fn a_rustfmt_toml_where_rcsc_runs_does_not_change_the_output() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_folder_without_plans_builds_nothing() {
+    let dir = temp("no_plans");
+    let plans = dir.join("plans");
+    std::fs::create_dir_all(&plans).unwrap();
+    let out = dir.join("out");
+    let o = rcsc_in(&dir, &["build", "plans", "-o", s(&out)]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("error[no_plans]"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(
+        tree(&dir).is_empty(),
+        "nothing written: {:?}",
+        paths(&tree(&dir))
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

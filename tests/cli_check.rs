@@ -391,3 +391,20 @@ fn assert_replays(case: &str, files: &[String], options: &[&str]) {
         text(&out.stderr)
     );
 }
+
+#[test]
+fn a_folder_without_plans_is_a_no_plans_error() {
+    let dir = scratch("no_plans", &[]);
+    let out = rcsc(&["check", dir.to_str().unwrap(), "--message-format", "json"]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+    let v: serde_json::Value =
+        serde_json::from_str(text(&out.stdout).lines().next().unwrap()).unwrap();
+    assert_eq!(v["code"], "no_plans", "{v}");
+    assert!(v["help"].as_str().unwrap().contains(".rcs"), "{v}");
+    // A manifest alone is no plans either.
+    std::fs::write(dir.join("rcs.yaml"), "system: empty\n").unwrap();
+    let out = rcsc(&["check", dir.to_str().unwrap(), "--message-format", "short"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = text(&out.stderr);
+    assert!(err.contains("rcs.yaml:1:1: error[no_plans]"), "{err}");
+}

@@ -1,7 +1,7 @@
 //! `rcsc doc`, `rcsc trace` and traces, end to end: the pages of a small
 //! plan set (snapshots of the pure generation), every link of the site
 //! for `plans/` resolving, byte-identical output, the site without
-//! Graphviz, trace versions, a run of the submarine example replayed
+//! Graphviz, `--open` without a browser, trace versions, a run of the submarine example replayed
 //! through `rcsc trace`, a large set documented cluster by cluster, and
 //! the Changes page of `rcsc doc --diff` (fixture: `tests/data/site/`).
 
@@ -168,6 +168,53 @@ fn without_graphviz_the_site_has_notices_instead_of_drawings() {
     assert!(files["PR.AHEAD.html"].contains("class=\"notice\""));
     assert!(!files["PR.AHEAD.html"].contains("<svg"));
     assert_eq!(broken_links(&files), Vec::<String>::new());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `rcsc doc plans/figure13 -q --open` into `out`, with no program on the
+/// PATH (an empty folder) and `$BROWSER` as given.
+fn doc_open(out: &Path, empty: &Path, browser: Option<&Path>) -> std::process::Output {
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_rcsc"));
+    cmd.args([
+        "doc",
+        "plans/figure13",
+        "-q",
+        "--open",
+        "-o",
+        out.to_str().unwrap(),
+    ])
+    .env("PATH", empty)
+    .env("NO_COLOR", "1");
+    match browser {
+        Some(b) => cmd.env("BROWSER", b),
+        None => cmd.env_remove("BROWSER"),
+    };
+    cmd.output().unwrap()
+}
+
+#[test]
+fn doc_open_without_a_browser_names_the_page_in_one_line() {
+    let dir = scratch("doc-nobrowser", &[]);
+    let out = dir.join("site");
+    let index = out.join("index.html");
+    let o = doc_open(&out, &dir, None);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("no browser") && err.contains(index.to_str().unwrap()),
+        "{err}"
+    );
+    assert!(index.is_file());
+    // A `$BROWSER` that fails is named.
+    let o = doc_open(&out, &dir, Some(&dir.join("no-such-browser")));
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("`$BROWSER`") && err.contains("no-such-browser"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -194,7 +194,16 @@ impl Config {
         let path = self.resolve(path)?;
         // Rerun on any change below the folder, even when loading fails.
         writeln!(cargo, "cargo::rerun-if-changed={}", path.display())?;
-        let sets = rcs_dsl::load_paths(std::slice::from_ref(&path))?;
+        let sets = match rcs_dsl::load_paths(std::slice::from_ref(&path)) {
+            Ok(sets) => sets,
+            Err(e) => {
+                // Cargo shows `cargo::error=` lines as the build's error;
+                // a build script's `main` would print only `Error: …`.
+                writeln!(cargo, "cargo::error={}", one_line(&e.to_string()))?;
+                writeln!(cargo, "cargo::error={}", self.load_hint(&path, &e))?;
+                return Err(e.into());
+            }
+        };
         for set in &sets {
             for id in set.rcs_files.iter().chain(&set.manifest_file) {
                 let name = &set.sources.get(*id).path;
@@ -257,6 +266,26 @@ impl Config {
             );
         };
         Ok(writer::write_tree(&out_dir, &files, &mut blocked)?)
+    }
+
+    /// What to do about a plan folder that cannot be read, for the second
+    /// `cargo::error=` line.
+    fn load_hint(&self, path: &Path, e: &LoadError) -> String {
+        match e {
+            LoadError::NotFound { .. } => format!(
+                "hint: `Config::compile` takes the plan-set folder relative to the crate's \
+                 `Cargo.toml` (`{}` was looked for there); create it or fix the path in build.rs",
+                path.display()
+            ),
+            LoadError::NotPlan { .. } => {
+                "hint: `Config::compile` takes a plan-set folder (or a workspace of them)"
+                    .to_string()
+            }
+            LoadError::Io { .. } => format!(
+                "hint: check that `{}` and the files below it can be read",
+                path.display()
+            ),
+        }
     }
 
     /// `path` against the manifest directory. When that is the current
@@ -515,7 +544,46 @@ mod tests {
             &dir,
         );
         assert!(matches!(r, Err(CompileError::Load(_))));
-        assert_eq!(cargo, "cargo::rerun-if-changed=DIR/plans\n");
+        let lines: Vec<&str> = cargo.lines().collect();
+        assert_eq!(lines[0], "cargo::rerun-if-changed=DIR/plans");
+        assert_eq!(
+            lines[1],
+            "cargo::error=DIR/plans: no such file or directory"
+        );
+        assert!(lines[2].starts_with("cargo::error=hint: "), "{cargo}");
+        assert!(
+            lines[2].contains("DIR/plans") && lines[2].contains("Cargo.toml"),
+            "{cargo}"
+        );
+        assert_eq!(lines.len(), 3, "{cargo}");
+        // `main`'s `Error: …` is one readable line, not a struct dump.
+        let shown = format!("{:?}", r.unwrap_err());
+        assert_eq!(
+            shown,
+            "DIR/plans: no such file or directory".replace("DIR", &dir.display().to_string())
+        );
+    }
+
+    #[test]
+    fn an_empty_folder_is_a_no_plans_error() {
+        let dir = scratch("empty", &[]);
+        std::fs::create_dir_all(dir.join("plans")).unwrap();
+        let (r, cargo, diags) = run(
+            Config::new().manifest_dir(&dir).out_dir(dir.join("o")),
+            &dir,
+        );
+        assert!(matches!(
+            r,
+            Err(CompileError::Diagnostics { errors: 1, .. })
+        ));
+        assert!(diags.contains("error[no_plans]"), "{diags}");
+        assert!(
+            cargo
+                .contains("cargo::error=could not compile the plans in `DIR/plans` due to 1 error"),
+            "{cargo}"
+        );
+        assert!(!dir.join("o").exists(), "nothing written");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     const GO: &str = "controller A {\n    command GO\n    plan GO {\n        *0 when new_command -> Done\n    }\n}\n";

@@ -70,11 +70,12 @@ pub enum Code {
     JobList,
     Instance,
     AcceptCondition,
+    NoPlans,
 }
 
 impl Code {
     /// Every hard-error code, in catalogue order (lints follow in [`Lint::ALL`]).
-    pub const ERRORS: [Code; 35] = [
+    pub const ERRORS: [Code; 36] = [
         Code::Syntax,
         Code::DuplicateDefinition,
         Code::UnknownName,
@@ -110,6 +111,7 @@ impl Code {
         Code::JobList,
         Code::Instance,
         Code::AcceptCondition,
+        Code::NoPlans,
     ];
 
     pub fn name(self) -> &'static str {
@@ -150,6 +152,7 @@ impl Code {
             Code::JobList => "job_list",
             Code::Instance => "instance",
             Code::AcceptCondition => "accept_condition",
+            Code::NoPlans => "no_plans",
         }
     }
 
@@ -193,6 +196,9 @@ impl Code {
             Code::Lint(Lint::UnreachableState) => "no path from the entry reaches a state",
             Code::Lint(Lint::DeadEndState) => "a state has no way out",
             Code::Lint(Lint::NoDone) => "a plan never reaches `Done` or `Error`",
+            Code::Lint(Lint::StateTypo) => {
+                "a state named once is one edit from another state, `Done`, `Error` or `same`: a typo"
+            }
             Code::Lint(Lint::SpanOfControl) => "a supervisor has too many subordinates",
             Code::Lint(Lint::LevelOrder) => "a subordinate's level is not below its supervisor's",
             Code::Lint(Lint::FloatEquality) => "floats compared with `==` or `!=`",
@@ -256,6 +262,7 @@ impl Code {
             Code::AcceptCondition => {
                 "an `accept when` condition calls a hook or reads a plan quantity of the plan it may replace"
             }
+            Code::NoPlans => "a plan set holds no `.rcs` file",
         }
     }
 

@@ -46,9 +46,11 @@ pub mod pretty;
 pub mod render;
 pub mod scenario;
 pub mod source;
+pub mod suggest;
 pub mod time;
 pub mod watchdog;
 pub mod yaml;
+mod yaml_layout;
 
 pub use diagnostic::{Code, Diagnostic, Diagnostics, Severity};
 pub use load::{load_folder, load_paths, LoadError, PlanSet};

@@ -14,6 +14,7 @@ pub enum Lint {
     UnreachableState,
     DeadEndState,
     NoDone,
+    StateTypo,
     SpanOfControl,
     LevelOrder,
     FloatEquality,
@@ -35,12 +36,13 @@ pub enum Lint {
 }
 
 impl Lint {
-    pub const ALL: [Lint; 23] = [
+    pub const ALL: [Lint; 24] = [
         Lint::RuleOfTen,
         Lint::ShadowedRow,
         Lint::UnreachableState,
         Lint::DeadEndState,
         Lint::NoDone,
+        Lint::StateTypo,
         Lint::SpanOfControl,
         Lint::LevelOrder,
         Lint::FloatEquality,
@@ -68,6 +70,7 @@ impl Lint {
             Lint::UnreachableState => "unreachable_state",
             Lint::DeadEndState => "dead_end_state",
             Lint::NoDone => "no_done",
+            Lint::StateTypo => "state_typo",
             Lint::SpanOfControl => "span_of_control",
             Lint::LevelOrder => "level_order",
             Lint::FloatEquality => "float_equality",
@@ -95,7 +98,7 @@ impl Lint {
 
     pub fn default_level(self) -> Level {
         match self {
-            Lint::RuleOfTen | Lint::ShadowedRow => Level::Deny,
+            Lint::RuleOfTen | Lint::ShadowedRow | Lint::StateTypo => Level::Deny,
             _ => Level::Warn,
         }
     }

@@ -20,6 +20,8 @@ use crate::source::{FileId, SourceMap, Span};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
+mod no_plans;
+
 /// A failure that is not a diagnostic: a path that cannot be read at all.
 /// The CLI exits with status 2 and this one-line reason.
 #[derive(Debug, thiserror::Error)]
@@ -321,6 +323,7 @@ fn load_tree(
         }
         let mut nested = Vec::new();
         set.collect_files(dir, &mut nested)?;
+        set.report_no_plans(dir, !nested.is_empty());
         let here = display(dir);
         sets.push(set);
         for n in nested {
@@ -341,6 +344,7 @@ fn load_tree(
         for p in direct {
             set.add_file(&p)?;
         }
+        set.report_no_plans(dir, false);
         sets.push(set);
         return Ok(());
     }

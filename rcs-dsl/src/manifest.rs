@@ -39,7 +39,8 @@ pub struct CpuSpec {
     pub name: String,
     pub span: Span,
     pub period_ns: u64,
-    /// Whether `period:` is given (else `period_ns` is the default).
+    /// Whether `period:` is given (always, once the manifest parses: a
+    /// CPU without one is a `manifest` error).
     pub period_given: bool,
     pub order: Vec<(String, Span)>,
     /// `process:`: the program this CPU runs in (`None`: the default
@@ -91,6 +92,13 @@ pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>>
                 Some(loc) => spanned(loc),
                 None => Span::new(id, 0, 0),
             };
+            if let Some(d) = e
+                .location
+                .as_ref()
+                .and_then(|loc| misindented(id, file, &e.message, loc))
+            {
+                return Err(vec![d]);
+            }
             let (message, label) = describe_yaml_error(&e.message);
             let d = Diagnostic::error(
                 Code::Manifest,
@@ -105,7 +113,10 @@ pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>>
                      lints {LINT: allow|warn|deny}, schedule [{cpu, period, order, process, inputs}]",
                 )
             } else {
-                d
+                d.with_help(
+                    "fix the YAML here: `key: value` pairs, lists as `[a, b]` or `- ` lines, \
+                     the keys of one mapping indented alike",
+                )
             };
             return Err(vec![d]);
         }
@@ -219,7 +230,25 @@ pub fn parse(id: FileId, file: &SourceFile) -> Result<Manifest, Vec<Diagnostic>>
         for cpu in schedule.value {
             let span = spanned(&cpu.cpu.referenced);
             let period_ns = match &cpu.period {
-                None => DEFAULT_PERIOD_NS,
+                None => {
+                    // A CPU of a schedule is an executive someone placed:
+                    // its period is theirs to choose, and one left out
+                    // would count every time in a period nobody chose.
+                    diags.push(
+                        Diagnostic::error(
+                            Code::Manifest,
+                            format!("CPU `{}` has no `period:`", cpu.cpu.value),
+                            key_span(file, id, span, "cpu"),
+                            "this schedule entry gives no period",
+                        )
+                        .with_help(format!(
+                            "give its period, with a unit: `{{ cpu: {}, period: 10ms, order: [...] }}` \
+                             (10ms is the default only of a plan set without `schedule:`)",
+                            cpu.cpu.value
+                        )),
+                    );
+                    DEFAULT_PERIOD_NS
+                }
                 Some(p) => match parse_duration(&p.value) {
                     Some(ns) if ns > MAX_PERIOD_NS => {
                         diags.push(
@@ -329,6 +358,59 @@ fn key_span(file: &SourceFile, id: FileId, value: Span, key: &str) -> Span {
         Some(i) => Span::new(id, line_start + i, line_start + i + key.len()),
         None => value,
     }
+}
+
+/// A YAML error that a mis-indented key caused, said at that key: what
+/// the library reported is kept as a note, with what YAML made of the key.
+fn misindented(
+    id: FileId,
+    file: &SourceFile,
+    message: &str,
+    loc: &yaml::Location,
+) -> Option<Diagnostic> {
+    let (line, column) = (loc.line() as usize, loc.column() as usize);
+    let (m, saw) = if let Some(key) = message
+        .strip_prefix("missing field `")
+        .and_then(|r| r.strip_suffix('`'))
+    {
+        let m = crate::yaml_layout::missing_key_elsewhere(&file.text, key, line, column)?;
+        let saw = if m.indent < m.expected {
+            format!(
+                "YAML ended the mapping that holds `{}:` before this line, so that mapping has no `{key}`",
+                m.sibling
+            )
+        } else {
+            format!("YAML read `{key}:` as part of the value before it, then found `{key}` missing in the mapping of `{}:`", m.sibling)
+        };
+        (m, saw)
+    } else if message.starts_with("mapping values are not allowed") {
+        let m = crate::yaml_layout::key_under_a_value(&file.text, line)?;
+        let saw = format!(
+            "YAML read this line as more of the value of `{}:` on the line above, where a key cannot start",
+            m.sibling
+        );
+        (m, saw)
+    } else {
+        return None;
+    };
+    let key = &file.text[m.start..m.end];
+    Some(
+        Diagnostic::error(
+            Code::Manifest,
+            format!(
+                "invalid `rcs.yaml`: `{key}:` is indented {} spaces, but `{}:` {}",
+                m.indent, m.sibling, m.expected
+            ),
+            Span::new(id, m.start, m.end),
+            "mis-indented key",
+        )
+        .with_note(saw)
+        .with_note(format!("the YAML library said: {message} (line {line})"))
+        .with_help(format!(
+            "indent `{key}:` by {} spaces, as `{}:`",
+            m.expected, m.sibling
+        )),
+    )
 }
 
 /// The YAML library's message in the manifest's words, and a label for it.

@@ -14,6 +14,7 @@ pub(crate) mod names;
 mod plan;
 mod report;
 mod time;
+mod typo;
 mod usage;
 mod value;
 
@@ -269,6 +270,7 @@ fn check_plan(
     graph::check_unreachable_states(c, p, analysis, sink);
     graph::check_dead_ends(c, p, analysis, sink);
     graph::check_no_done(ir, c, p, analysis, sink);
+    typo::check_state_typos(c, p, sink);
     hang::check_incomplete_states(c, p, conditions, analysis, sink);
     loops::check_livelocks(ir, c, p, conditions, sink);
     loops::check_command_storms(ir, c, p, conditions, sink);

@@ -120,6 +120,16 @@ impl ConstTable {
             .or_else(|| self.file.get(name))
     }
 
+    /// The names of the constants seen from controller `ctrl` (or from
+    /// file level), for "did you mean".
+    pub fn names(&self, ctrl: Option<usize>) -> impl Iterator<Item = &str> {
+        ctrl.and_then(|c| self.ctrl.get(c))
+            .into_iter()
+            .flat_map(|m| m.keys())
+            .chain(self.file.keys())
+            .map(String::as_str)
+    }
+
     /// Whether a file-level constant has this name.
     pub fn is_file_const(&self, name: &str) -> bool {
         self.file.contains_key(name)

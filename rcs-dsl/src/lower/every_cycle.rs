@@ -169,6 +169,13 @@ impl Cx<'_, '_> {
                 )
                 .with_help(
                     "`cmd.P` in `pre` and `post` reads parameter P of the command being executed",
+                )
+                .suggest(
+                    param,
+                    self.c
+                        .commands
+                        .iter()
+                        .flat_map(|c| c.params.iter().map(|p| p.name.as_str())),
                 ),
             );
             return (err_expr(span), Ty::Err);
@@ -231,9 +238,7 @@ impl Cx<'_, '_> {
     pub(in crate::lower) fn sub_offers(&self, cid: CtrlId, name: &str) -> String {
         let sub = &self.ir.controllers[cid.index()];
         let fields: Vec<&str> = sub.status_fields().map(|(_, v)| v.name.as_str()).collect();
-        let close = fields
-            .iter()
-            .find(|f| f.eq_ignore_ascii_case(name) || edit_distance_one(f, name));
+        let close = crate::suggest::closest(name, fields.iter().copied());
         let mut help =
             "a subordinate offers `status`, `done`, `executing`, `error` and `stale_cycles`"
                 .to_string();
@@ -244,21 +249,6 @@ impl Cx<'_, '_> {
             help = format!("did you mean `{}.{f}`? {help}", sub.name);
         }
         help
-    }
-}
-
-/// `a` and `b` differ by one inserted, deleted or replaced character.
-fn edit_distance_one(a: &str, b: &str) -> bool {
-    let (a, b) = (a.as_bytes(), b.as_bytes());
-    let (short, long) = if a.len() <= b.len() { (a, b) } else { (b, a) };
-    if long.len() - short.len() > 1 {
-        return false;
-    }
-    let prefix = short.iter().zip(long).take_while(|(x, y)| x == y).count();
-    if short.len() == long.len() {
-        short[prefix + 1.min(short.len() - prefix)..] == long[prefix + 1.min(long.len() - prefix)..]
-    } else {
-        short[prefix..] == long[prefix + 1..]
     }
 }
 

@@ -110,6 +110,12 @@ pub(super) fn lower_controller_headers<'a>(
                                     )
                                     .with_help(
                                         "subordinates are controllers declared in this plan set",
+                                    )
+                                    .suggest(
+                                        &n.text,
+                                        g.names.iter().filter_map(|(k, (r, _))| {
+                                            matches!(r, ItemRef::Controller(_)).then_some(*k)
+                                        }),
                                     ),
                                 );
                                 continue;

@@ -173,7 +173,8 @@ impl Cx<'_, '_> {
                             name.span,
                             "not declared",
                         )
-                        .with_help(format!("declare it: `status {}`", name.text)),
+                        .with_help(format!("declare it: `status {}`", name.text))
+                        .suggest(&name.text, self.c.statuses.iter().map(|s| s.name.as_str())),
                     );
                     None
                 }
@@ -248,7 +249,8 @@ impl Cx<'_, '_> {
                         sub.span,
                         "not a subordinate",
                     )
-                    .with_help(help),
+                    .with_help(help)
+                    .suggest(&sub.text, self.subordinate_names()),
                 );
                 None
             }
@@ -289,7 +291,8 @@ impl Cx<'_, '_> {
                         .map(|c| c.name.as_str())
                         .collect::<Vec<_>>()
                         .join(", ")
-                )),
+                ))
+                .suggest(&verb.text, target.commands.iter().map(|c| c.name.as_str())),
             );
             infer_all(self);
             return None;
@@ -446,7 +449,8 @@ impl Cx<'_, '_> {
                             }
                             None => {
                                 self.diags.push(Diagnostic::error(Code::UnknownName, format!("buffer type `{}` has no field `{}`", bty.name, f.text), f.span, "no such field")
-                                    .with_help(format!("the fields are: {}", bty.fields.iter().map(|f| f.name.as_str()).collect::<Vec<_>>().join(", "))));
+                                    .with_help(format!("the fields are: {}", bty.fields.iter().map(|f| f.name.as_str()).collect::<Vec<_>>().join(", ")))
+                                    .suggest(&f.text, bty.fields.iter().map(|f| f.name.as_str())));
                                 None
                             }
                         }
@@ -560,8 +564,11 @@ impl Cx<'_, '_> {
                 format!("declare it: `error {}`", code.text),
             ),
         };
-        self.diags
-            .push(Diagnostic::error(Code::UnknownName, message, code.span, label).with_help(help));
+        self.diags.push(
+            Diagnostic::error(Code::UnknownName, message, code.span, label)
+                .with_help(help)
+                .suggest(&code.text, self.c.errors.iter().map(|e| e.name.as_str())),
+        );
         None
     }
 

@@ -132,7 +132,13 @@ pub(crate) fn resolve_type_in(
                             "declare it with `enum {0} {{ … }}` or `buffer {0} {{ … }}`, or use one of {1}",
                             n.text,
                             PRIMITIVES.join(", ")
-                        ) }),
+                        ) })
+                        .suggest(
+                            &n.text,
+                            PRIMITIVES.into_iter().chain(g.names.iter().filter_map(|(k, (r, _))| {
+                                (!matches!(r, ItemRef::Controller(_))).then_some(*k)
+                            })),
+                        ),
                     );
                     None
                 }

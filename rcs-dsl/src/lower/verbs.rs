@@ -71,7 +71,8 @@ impl Cx<'_, '_> {
                         v.span,
                         "no such command",
                     )
-                    .with_help(format!("declare it: `command {}`", v.text)),
+                    .with_help(format!("declare it: `command {}`", v.text))
+                    .suggest(&v.text, self.c.commands.iter().map(|c| c.name.as_str())),
                 );
                 ok = false;
                 continue;

@@ -125,8 +125,10 @@ impl Folder<'_, '_> {
                             v.span,
                             "no such variant",
                         );
-                        self.diags
-                            .push(d.with_help(format!("the variants are: {}", all.join(", "))));
+                        self.diags.push(
+                            d.with_help(format!("the variants are: {}", all.join(", ")))
+                                .suggest(&v.text, all.iter().copied()),
+                        );
                         None
                     }
                 }
@@ -289,7 +291,15 @@ impl Folder<'_, '_> {
                 "a file-level constant may use file-level constants, enum variants and built-in functions"
             } else {
                 "declare it with `const NAME: TYPE = VALUE`"
-            }),
+            })
+            .suggest(
+                &n.text,
+                self.defs
+                    .keys()
+                    .filter(|(s, _)| s.is_none() || *s == scope)
+                    .map(|(_, name)| name.as_str())
+                    .chain(self.g.consts_table.names(scope)),
+            ),
         );
         None
     }

@@ -117,6 +117,15 @@ impl Cx<'_, '_> {
         self.names().values.get(name).copied()
     }
 
+    /// The names of this controller's subordinates (for "did you mean").
+    pub(in crate::lower) fn subordinate_names(&self) -> impl Iterator<Item = &str> {
+        let ir = self.ir;
+        self.c
+            .subordinates
+            .iter()
+            .map(move |s| ir.controllers[s.index()].name.as_str())
+    }
+
     /// This controller's names, indexed.
     pub(in crate::lower) fn names(&self) -> &ControllerNames {
         &self.ix.controllers[self.ctrl.index()]
@@ -335,7 +344,8 @@ impl Cx<'_, '_> {
                                 p.span,
                                 "no such parameter",
                             )
-                            .with_help(have),
+                            .with_help(have)
+                            .suggest(&p.text, command.params.iter().map(|p| p.name.as_str())),
                         );
                         (err_expr(span), Ty::Err)
                     }

@@ -86,7 +86,8 @@ impl Cx<'_, '_> {
                                         .map(|v| v.name.as_str())
                                         .collect::<Vec<_>>()
                                         .join(", ")
-                                )),
+                                ))
+                                .suggest(&name.text, en.variants.iter().map(|v| v.name.as_str())),
                             );
                             (err_expr(span), Ty::Err)
                         }
@@ -100,23 +101,32 @@ impl Cx<'_, '_> {
                             Ty::Known(Type::Status(*cid)),
                         ),
                         None => {
-                            self.diags.push(Diagnostic::error(
-                                Code::UnknownName,
-                                format!("controller `{}` has no status `{}`", ctrl.name, name.text),
-                                name.span,
-                                "no such status",
-                            ));
+                            self.diags.push(
+                                Diagnostic::error(
+                                    Code::UnknownName,
+                                    format!(
+                                        "controller `{}` has no status `{}`",
+                                        ctrl.name, name.text
+                                    ),
+                                    name.span,
+                                    "no such status",
+                                )
+                                .suggest(&name.text, ctrl.statuses.iter().map(|s| s.name.as_str())),
+                            );
                             (err_expr(span), Ty::Err)
                         }
                     }
                 }
                 _ => {
-                    self.diags.push(Diagnostic::error(
-                        Code::UnknownName,
-                        format!("unknown enum `{}`", q.text),
-                        q.span,
-                        "not an enum or controller",
-                    ));
+                    self.diags.push(
+                        Diagnostic::error(
+                            Code::UnknownName,
+                            format!("unknown enum `{}`", q.text),
+                            q.span,
+                            "not an enum or controller",
+                        )
+                        .suggest(&q.text, self.g.names.keys().copied()),
+                    );
                     (err_expr(span), Ty::Err)
                 }
             };
@@ -200,7 +210,8 @@ impl Cx<'_, '_> {
                             .map(|s| s.name.as_str())
                             .collect::<Vec<_>>()
                             .join(", ")
-                    )),
+                    ))
+                    .suggest(&name.text, ctrl.statuses.iter().map(|s| s.name.as_str())),
                 );
                 return (err_expr(span), Ty::Err);
             }
@@ -254,9 +265,21 @@ impl Cx<'_, '_> {
                             name.text, self.c.name
                         ));
                     } else {
-                        d = d.with_help(
-                            "declare it as a `var`, a `reads`/`writes` buffer, or an enum variant",
-                        );
+                        d = d
+                            .with_help(
+                                "declare it as a `var`, a `reads`/`writes` buffer, or an enum variant",
+                            )
+                            .suggest(
+                                &name.text,
+                                self.names()
+                                    .values
+                                    .keys()
+                                    .map(String::as_str)
+                                    .chain(self.g.consts_table.names(Some(self.ctrl.index())))
+                                    .chain(self.ir.enums.iter().flat_map(|en| {
+                                        en.variants.iter().map(|v| v.name.as_str())
+                                    })),
+                            );
                     }
                 }
                 self.diags.push(d);
@@ -318,7 +341,13 @@ impl Cx<'_, '_> {
                             name.text
                         ),
                         (None, None) => format!("declare it: `hook {}(…) -> T`", name.text),
-                    }),
+                    })
+                    .suggest(
+                        &name.text,
+                        self.names().values.iter().filter_map(|(k, v)| {
+                            matches!(v, Value::Hook(_)).then_some(k.as_str())
+                        }),
+                    ),
                 );
                 for a in args {
                     self.infer_untyped(a);
@@ -416,7 +445,11 @@ impl Cx<'_, '_> {
                         .with_help(format!(
                             "`.{}` reads the status of a subordinate: a controller declared in this plan set and listed in `{}`'s `subordinates`",
                             field.text, self.c.name
-                        )),
+                        ))
+                        .suggest(
+                            &x.text,
+                            self.subordinate_names(),
+                        ),
                     );
                     return (err_expr(span), Ty::Err);
                 }
@@ -458,7 +491,8 @@ impl Cx<'_, '_> {
                                     .collect::<Vec<_>>()
                                     .join(", ")
                             ))
-                            .with_secondary(bty.name_span, format!("`{}` declared here", bty.name)),
+                            .with_secondary(bty.name_span, format!("`{}` declared here", bty.name))
+                            .suggest(&field.text, bty.fields.iter().map(|f| f.name.as_str())),
                         );
                         (err_expr(span), Ty::Err)
                     }
@@ -505,6 +539,7 @@ impl Cx<'_, '_> {
                     "not a subordinate",
                 )
                 .with_help(format!("add it to `{}`'s `subordinates` list", self.c.name))
+                .suggest(&x.text, self.subordinate_names())
             };
             self.diags.push(d);
             return (err_expr(span), Ty::Err);
@@ -593,7 +628,8 @@ impl Cx<'_, '_> {
                 name.span,
                 "no such error code",
             )
-            .with_help(help),
+            .with_help(help)
+            .suggest(&name.text, codes.iter().copied()),
         );
         (err_expr(span), Ty::Err)
     }

@@ -119,7 +119,8 @@ impl Builder {
                                 .with_help(format!(
                                     "the lints are: {}",
                                     Lint::ALL.map(Lint::name).join(", ")
-                                )),
+                                ))
+                                .suggest(name.as_str(), Lint::ALL.map(Lint::name)),
                             ),
                         }
                     }

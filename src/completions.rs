@@ -176,3 +176,39 @@ fn write_stdout(bytes: &[u8]) -> ExitCode {
         Err(e) => fail(format!("cannot write to stdout: {e}")),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_command_line_definition_is_consistent() {
+        // What clap checks lazily (duplicate flags, bad defaults) is checked
+        // here for every subcommand, so completions and pages describe a
+        // definition clap accepts.
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn non_ascii_becomes_a_groff_escape() {
+        let mut text = String::new();
+        push_ascii(&mut text, "a … → b");
+        assert_eq!(text, "a \\[u2026] \\[u2192] b");
+    }
+
+    #[test]
+    fn only_pages_rcsc_wrote_may_be_replaced() {
+        let dir = std::env::temp_dir().join(format!("rcsc-may-replace-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let ours = dir.join("ours.1");
+        std::fs::write(&ours, format!("{}.TH x 1\n", marker())).unwrap();
+        assert_eq!(may_replace(&ours), Ok(()));
+        assert_eq!(may_replace(&dir.join("absent.1")), Ok(()));
+        let theirs = dir.join("theirs.1");
+        std::fs::write(&theirs, ".TH x 1\n").unwrap();
+        assert!(may_replace(&theirs)
+            .unwrap_err()
+            .contains("not written by rcsc"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -53,6 +53,12 @@ pub(crate) enum Command {
     /// Make a development CA and per-process certificates for a distributed plan set.
     #[command(after_help = crate::certs_cmd::CERTS_HELP)]
     Certs(crate::certs_cmd::CertsArgs),
+    /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
+    #[command(after_help = crate::completions::COMPLETIONS_HELP)]
+    Completions(crate::completions::CompletionsArgs),
+    /// Print the man page, or write one page per subcommand into a folder.
+    #[command(after_help = crate::completions::MAN_HELP)]
+    Man(crate::completions::ManArgs),
 }
 
 const DIFF_HELP: &str = "\

@@ -10,6 +10,7 @@ mod args;
 mod certs_cmd;
 mod commands;
 mod compiled;
+mod completions;
 mod diff_cmd;
 mod doc_cmd;
 mod output;
@@ -33,6 +34,8 @@ fn main() -> ExitCode {
         Command::Doc(args) => doc_cmd::doc(args),
         Command::Trace(args) => trace_cmd::trace(args),
         Command::Certs(args) => certs_cmd::certs(args),
+        Command::Completions(args) => completions::completions(args),
+        Command::Man(args) => completions::man(args),
     }
 }
 

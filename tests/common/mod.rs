@@ -29,6 +29,7 @@ pub fn text(bytes: &[u8]) -> String {
 /// A fresh temporary folder holding `files` (paths may have folders). Its
 /// name carries the test binary, the process and `name`, so tests running
 /// in parallel never share one.
+#[allow(dead_code)] // each test binary compiles this module; not all use it
 pub fn scratch(name: &str, files: &[(&str, &str)]) -> PathBuf {
     let binary = std::env::current_exe()
         .ok()

@@ -177,8 +177,23 @@ pub struct JsonLabel {
     pub primary: bool,
 }
 
+/// The name in every JSON diagnostic's `format` field.
+pub const JSON_FORMAT: &str = "rcsc-diagnostic";
+
+/// The version of the JSON diagnostic format (docs/diagnostics-json.md,
+/// `docs/diagnostic.schema.json`). A new field readers may ignore keeps it;
+/// a field removed, renamed or given another meaning raises it.
+pub const JSON_VERSION: u32 = 1;
+
+/// One diagnostic in the JSON format: the fields, their order and their
+/// meaning are the documented, versioned schema.
 #[derive(Serialize)]
 pub struct JsonDiagnostic {
+    /// Always [`JSON_FORMAT`]: lets a reader of mixed output tell a
+    /// diagnostic from other JSON lines.
+    pub format: &'static str,
+    /// Always [`JSON_VERSION`].
+    pub version: u32,
     pub code: &'static str,
     pub severity: &'static str,
     pub message: String,
@@ -206,6 +221,8 @@ fn position(sources: &SourceMap, span: Span) -> (String, usize, usize, usize, us
 pub fn json(d: &Diagnostic, sources: &SourceMap) -> JsonDiagnostic {
     let (file, line, column, end_line, end_column) = position(sources, d.primary_span());
     JsonDiagnostic {
+        format: JSON_FORMAT,
+        version: JSON_VERSION,
         code: d.code.name(),
         severity: d.severity.as_str(),
         message: d.message.clone(),

@@ -158,8 +158,10 @@ pub(crate) struct TestArgs {
 }
 
 const MAIN_HELP: &str = "\
-A PATH is a plan-set folder (every *.rcs below it, plus its optional rcs.yaml)
-or one or more .rcs files; the default is the current folder.
+A PATH is a plan-set folder (every *.rcs below it, plus its optional rcs.yaml),
+a workspace (a folder whose subfolders are plan sets, or an rcs.yaml with
+`workspace: [folder, ...]`), or one or more .rcs files; the default is the
+current folder.
 
 Exit status: 0 success (warnings allowed), 1 a diagnostic with an error,
 2 a usage or I/O problem (with a one-line reason).

@@ -89,3 +89,27 @@ fn too_few_cycles_fail_with_a_message() {
         "{stderr}"
     );
 }
+
+/// The README's sample of `--fast` (section "Run the examples"): every line
+/// of it is a line of the real output, in the same order (the sample leaves
+/// rows out, never changes one).
+#[test]
+fn the_readme_sample_is_what_fast_prints() {
+    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../README.md"))
+        .expect("README.md");
+    let start = readme
+        .find("```text\ncycle | SM")
+        .expect("README.md shows a --fast table")
+        + "```text\n".len();
+    let end = start + readme[start..].find("```").expect("the block ends");
+    let sample: Vec<&str> = readme[start..end].lines().collect();
+    let (out, stdout) = run(&["--fast"]);
+    assert!(out.status.success(), "exit {:?}\n{stdout}", out.status);
+    let mut lines = stdout.lines().map(str::trim_end);
+    for want in &sample {
+        assert!(
+            lines.any(|l| l == want.trim_end()),
+            "README.md's --fast sample has a line the run does not print (in this order):\n{want}\n\nthe run printed:\n{stdout}"
+        );
+    }
+}

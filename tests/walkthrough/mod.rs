@@ -5,10 +5,12 @@
 //! builds and runs it offline against that checkout's lock file, and its
 //! output must start each line of the ```text output block.
 //!
-//! Then two mistakes a newcomer makes, on the same crate: naming a plan set
+//! Then four mistakes a newcomer makes, on the same crate: naming a plan set
 //! the build script did not compile (`include_plans!` must say which ones
-//! it did), and a plan with an error (the build fails with the diagnostic,
-//! and the summary is not repeated over and over).
+//! it did), a plan with an error (the build fails with the diagnostic,
+//! and the summary is not repeated over and over), a plan-set path that
+//! does not exist (`cargo::error=` lines with the path and a hint) and an
+//! empty plan-set folder (`no_plans`).
 
 use crate::markdown::blocks;
 use std::path::Path;
@@ -121,6 +123,37 @@ pub fn run(readme: &str, rcsc: &Path, target: &Path) {
         "{stderr}"
     );
     std::fs::write(&plan, good).unwrap();
+
+    // The plan-set folder is not where build.rs says: cargo's own error
+    // lines (`cargo::error=`) name the path and say what to do, and the
+    // build script's `main` does not add a Debug-formatted `Error:`.
+    let plans = dir.join("plans/submarine");
+    let away = dir.join("plans-away");
+    std::fs::rename(&plans, &away).unwrap();
+    let out = cargo(&["build", "--quiet"]);
+    let stderr = text(&out.stderr);
+    assert!(!out.status.success());
+    let errors: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("error: ") && l.contains("plans/submarine"))
+        .collect();
+    assert!(
+        errors.iter().any(|l| l.contains("hint: `Config::compile` takes the plan-set folder relative to the crate's `Cargo.toml`")),
+        "no cargo::error hint naming the path:\n{stderr}"
+    );
+    assert!(
+        !stderr.contains("NotFound {"),
+        "a Debug-formatted error:\n{stderr}"
+    );
+
+    // An empty plan-set folder is an error (`no_plans`), not an empty system.
+    std::fs::create_dir_all(&plans).unwrap();
+    let out = cargo(&["build", "--quiet"]);
+    let stderr = text(&out.stderr);
+    assert!(!out.status.success(), "an empty plan set built:\n{stderr}");
+    assert!(stderr.contains("error[no_plans]"), "{stderr}");
+    std::fs::remove_dir_all(&plans).unwrap();
+    std::fs::rename(&away, &plans).unwrap();
     std::fs::remove_dir_all(dir).ok();
 }
 

@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
-use common::text;
+use common::{copy_tree, text};
 
 fn readme() -> String {
     std::fs::read_to_string("README.md").expect("README.md")
@@ -73,19 +73,6 @@ fn field<'a>(comment: &'a str, key: &str) -> Option<&'a str> {
     comment
         .lines()
         .find_map(|l| l.trim().strip_prefix(key).map(str::trim))
-}
-
-fn copy_tree(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).expect("scratch folder");
-    for e in std::fs::read_dir(from).expect("readable") {
-        let p = e.expect("entry").path();
-        let dest = to.join(p.file_name().expect("name"));
-        if p.is_dir() {
-            copy_tree(&p, &dest);
-        } else {
-            std::fs::copy(&p, &dest).expect("copy");
-        }
-    }
 }
 
 fn scratch_copy(line: usize) -> PathBuf {

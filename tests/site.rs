@@ -10,7 +10,7 @@ mod common;
 mod plan_set;
 
 use common::site_links::broken_links;
-use common::{rcsc, scratch, text, tree};
+use common::{copy_tree, rcsc, scratch, text, tree};
 use rcs_codegen::site::{self, SetDoc, Site, Svgs};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -494,4 +494,126 @@ fn a_large_set_is_documented_cluster_by_cluster() {
     assert!(files
         .iter()
         .all(|(p, t)| !p.ends_with(".html") || !t.contains("search.js")));
+}
+
+/// A plan set whose doc comments try Markdown and hostile HTML, with a
+/// finding that has a witness.
+const POLISH: &str = "\
+/// Feeds parts. Ends in `Error` when the *sensor* fails; see
+/// [the cell](https://example.org/cell) or [this](javascript:alert(1)).
+/// <script>alert(1)</script>
+controller Feeder {
+    reads s: Sensor
+    command FEED
+    status FED
+    error TIMEOUT
+    plan FEED {
+        E0: *0 when new_command -> S1
+        E1: S1 when state_cycles > 20 -> Error(TIMEOUT)
+        E2: S1 when !s.ready -> S2
+        E3: S1 when s.ready -> Done { report FED }
+        E4: S2 when !s.ready -> S1
+        E5: S2 when s.ready -> Done
+    }
+}
+buffer Sensor { ready: bool }
+";
+
+#[test]
+fn the_site_renders_docs_as_markdown_and_says_each_thing_once() {
+    let dir = scratch("polish", &[("plans/feeder.rcs", POLISH)]);
+    let out = dir.join("site");
+    let o = rcsc(&[
+        "doc",
+        dir.join("plans").to_str().unwrap(),
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let files = site_of(&out);
+    // The one link out is the one the doc comment wrote.
+    assert_eq!(
+        broken_links(&files),
+        ["Feeder.html: https://example.org/cell (leads outside the site)"]
+    );
+    let ctrl = &files["Feeder.html"];
+    // Markdown, and nothing a browser would run.
+    assert!(ctrl.contains("<code>Error</code>"), "{ctrl}");
+    assert!(ctrl.contains("<em>sensor</em>"), "{ctrl}");
+    assert!(ctrl.contains("<a href=\"https://example.org/cell\">the cell</a>"));
+    assert!(!ctrl.contains("<script>alert"), "{ctrl}");
+    assert!(!ctrl.contains("javascript:"), "{ctrl}");
+    // Statuses and errors say what they are and which rows give them.
+    assert!(ctrl.contains("No command has arrived yet"), "{ctrl}");
+    assert!(ctrl.contains("rows reporting it: <a href=\"Feeder.FEED.html#row-E3\">FEED E3</a>"));
+    assert!(ctrl.contains("rows ending with it: <a href=\"Feeder.FEED.html#row-E1\">FEED E1</a>"));
+    assert!(ctrl.contains("REFUSED <small>(built in)</small>"));
+    // The livelock's witness once, not also as its terminal note; names
+    // in its message as code.
+    let plan = &files["Feeder.FEED.html"];
+    assert_eq!(plan.matches("class=\"witness\"").count(), 1, "{plan}");
+    assert!(!plan.contains("for example, in state"), "{plan}");
+    assert!(plan.contains("plan <code>FEED</code> can loop"), "{plan}");
+    // S0 is explained where it is listed.
+    assert!(plan.contains("where every command starts; not drawn as a state: the entry row <a href=\"#row-E0\">E0</a> leaves it"));
+    // The index: contents and counts.
+    let index = &files["index.html"];
+    assert!(index.contains("<nav class=\"toc\">"), "{index}");
+    assert!(
+        index.contains("<span class=\"count warning\">1 warning</span>"),
+        "{index}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_changes_page_says_each_kind_once_and_no_heading_stands_empty() {
+    let dir = scratch("changes-words", &[]);
+    let old = dir.join("old");
+    copy_tree(Path::new("plans/submarine"), &old.join("submarine"));
+    let out = dir.join("site");
+    let o = rcsc(&[
+        "doc",
+        "plans/",
+        "--diff",
+        old.to_str().unwrap(),
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let changes = &site_of(&out)["diff-changes.html"];
+    for set in ["figure13", "rcs_ex", "packml"] {
+        let at = changes
+            .find(&format!("<h2>System {set} (added)</h2>"))
+            .unwrap_or_else(|| panic!("{set} added:\n{changes}"));
+        let next = &changes[at..changes[at..].find("</section>").unwrap() + at];
+        assert!(next.contains("A new plan set:"), "{next}");
+    }
+    // Against the decls_changed case: a kind word never doubled.
+    let out2 = dir.join("site2");
+    let o = rcsc(&[
+        "doc",
+        "tests/data/diff/decls_changed/new",
+        "--diff",
+        "tests/data/diff/decls_changed/old",
+        "-q",
+        "-o",
+        out2.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let changes = &site_of(&out2)["diff-changes.html"];
+    assert!(
+        changes.contains("<code>command DRAIN(rate: u8)</code>"),
+        "{changes}"
+    );
+    for doubled in [
+        "command <code>command",
+        "status <code>status",
+        "buffer type <code>buffer",
+    ] {
+        assert!(!changes.contains(doubled), "{doubled}: {changes}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -321,6 +321,25 @@ pub struct Witness {
     pub system: Option<crate::scenario::SystemScript>,
 }
 
+/// The `for example, in state S: a = 1, b = 2` note of a witness.
+fn example_note<'a>(state: &str, inputs: impl Iterator<Item = (&'a str, &'a str)>) -> String {
+    let shown: Vec<String> = inputs.map(|(n, v)| format!("{n} = {v}")).collect();
+    format!("for example, in state {state}: {}", shown.join(", "))
+}
+
+impl Witness {
+    /// The note [`Diagnostic::with_witness`] adds for this witness: a
+    /// renderer that shows the witness itself leaves that note out.
+    pub fn example_note(&self) -> String {
+        example_note(
+            &self.state,
+            self.inputs
+                .iter()
+                .map(|i| (i.name.as_str(), i.value.as_str())),
+        )
+    }
+}
+
 /// What a cross-controller finding's system run needs of the subordinate.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Across {
@@ -404,10 +423,9 @@ impl Diagnostic {
 
     /// The witness of a "can happen" finding, also as a `for example:` note.
     pub fn with_witness(mut self, state: &str, inputs: &[(String, String)]) -> Self {
-        let shown: Vec<String> = inputs.iter().map(|(n, v)| format!("{n} = {v}")).collect();
-        self.notes.push(format!(
-            "for example, in state {state}: {}",
-            shown.join(", ")
+        self.notes.push(example_note(
+            state,
+            inputs.iter().map(|(n, v)| (n.as_str(), v.as_str())),
         ));
         self.witness = Some(Witness {
             state: state.to_string(),

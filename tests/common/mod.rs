@@ -46,6 +46,21 @@ pub fn scratch(name: &str, files: &[(&str, &str)]) -> PathBuf {
     dir
 }
 
+/// `cp -r from to`.
+#[allow(dead_code)] // each test binary compiles this module; not all use it
+pub fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let p = e.unwrap().path();
+        let dest = to.join(p.file_name().unwrap());
+        if p.is_dir() {
+            copy_tree(&p, &dest);
+        } else {
+            std::fs::copy(&p, &dest).unwrap();
+        }
+    }
+}
+
 /// Every file below `dir`: `/`-separated relative path → bytes.
 #[allow(dead_code)] // each test binary compiles this module; not all use it
 pub fn tree(dir: &Path) -> BTreeMap<String, Vec<u8>> {

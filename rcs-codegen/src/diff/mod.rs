@@ -42,6 +42,22 @@ pub(crate) fn item_line(i: &ItemChange) -> (char, String) {
     }
 }
 
+/// An item as one says it: its kind, then its text — unless the text
+/// already starts with the kind's keyword (`command DRAIN(rate: u8)`,
+/// `buffer Sensors { … }`), where the kind would only repeat it.
+pub(crate) fn item_label(i: &ItemChange) -> String {
+    let (_, text) = item_line(i);
+    let keyword = i.kind.split(' ').next().unwrap_or(i.kind);
+    let says_kind = text
+        .strip_prefix(keyword)
+        .is_some_and(|rest| rest.starts_with(' '));
+    if says_kind {
+        text
+    } else {
+        format!("{} {text}", i.kind)
+    }
+}
+
 /// `E1 (was E2) now precedes E2 (was E1): …` and what that does.
 pub(crate) fn move_line(m: &Move) -> String {
     let was = |now: &str, was: &str| {

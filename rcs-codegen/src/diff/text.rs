@@ -45,8 +45,8 @@ pub fn text(diff: &PlanSetDiff, color: bool) -> String {
             paint.bold(&format!("system {}{}", s.name, presence(s.presence)))
         );
         for i in &s.items {
-            let (m, t) = item_line(i);
-            let _ = writeln!(out, "  {}", paint.mark(m, &format!("{} {t}", i.kind)));
+            let (m, _) = item_line(i);
+            let _ = writeln!(out, "  {}", paint.mark(m, &item_label(i)));
         }
         for c in &s.controllers {
             let _ = writeln!(

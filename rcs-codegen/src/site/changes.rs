@@ -11,7 +11,7 @@
 use super::html::{esc, page};
 use super::index::graph_or_notice;
 use super::{ctrl_page, folder, plan_page, Changes, GraphSource, SetDoc, Site, Svgs};
-use crate::diff::{changed_parts, item_line, move_line, presence, row_name, row_word};
+use crate::diff::{changed_parts, item_label, item_line, move_line, presence, row_name, row_word};
 use rcs_dsl::diff::{ControllerDiff, Finding, ItemChange, PlanDiff, RowChange, SystemDiff};
 use rcs_dsl::ir::{Controller, Plan};
 use std::fmt::Write;
@@ -151,6 +151,28 @@ pub(super) fn changes_page(site: &Site, changes: &Changes, svgs: &Svgs) -> Strin
             presence(s.presence)
         );
         items(&mut body, &s.items);
+        if s.items.is_empty() && s.controllers.is_empty() {
+            // A set added or removed whole: say so instead of an empty
+            // heading.
+            let line = match (s.presence, set) {
+                (rcs_dsl::diff::Presence::Added, Some(set)) => {
+                    let plans: usize = set.ir.controllers.iter().map(|c| c.plans.len()).sum();
+                    format!(
+                        "A new plan set: {} controller{}, {plans} plan{}; see <a href=\"index.html#set-{}\">its part of the index</a>.",
+                        set.ir.controllers.len(),
+                        if set.ir.controllers.len() == 1 { "" } else { "s" },
+                        if plans == 1 { "" } else { "s" },
+                        esc(&set.ir.system)
+                    )
+                }
+                (rcs_dsl::diff::Presence::Removed, _) => format!(
+                    "The plan set is gone: <code>{}</code> had it, the plans documented here do not.",
+                    esc(&changes.against)
+                ),
+                _ => "Nothing changed in its declarations or plans.".to_string(),
+            };
+            let _ = writeln!(body, "<p class=\"whole-set\">{line}</p>");
+        }
         for c in &s.controllers {
             let ctrl = set.and_then(|set| set.ir.controllers.iter().find(|k| k.name == c.name));
             let name = match ctrl {
@@ -287,7 +309,7 @@ fn items(body: &mut String, list: &[ItemChange]) {
     }
     body.push_str("<ul class=\"items\">\n");
     for i in list {
-        let (mark, text) = item_line(i);
+        let (mark, _) = item_line(i);
         let class = match mark {
             '+' => "added",
             '-' => "removed",
@@ -295,9 +317,8 @@ fn items(body: &mut String, list: &[ItemChange]) {
         };
         let _ = writeln!(
             body,
-            "<li class=\"{class}\">{} <code>{}</code></li>",
-            esc(i.kind),
-            esc(&text)
+            "<li class=\"{class}\"><code>{}</code></li>",
+            esc(&item_label(i))
         );
     }
     body.push_str("</ul>\n");
@@ -319,7 +340,7 @@ fn findings(body: &mut String, title: &str, list: &[Finding]) {
             "<li><code>{}</code> {}: {}</li>",
             esc(&f.code),
             esc(&f.place()),
-            esc(&f.message)
+            super::markdown::message_html(&f.message)
         );
     }
     body.push_str("</ul>\n");

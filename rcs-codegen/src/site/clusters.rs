@@ -424,7 +424,7 @@ pub(super) fn pages(site: &Site, set: &SetDoc, svgs: &Svgs) -> Vec<crate::Output
             svgs.get(&cluster_key(&folder, cl)),
             &cl.title,
         ));
-        body.push_str(&controllers_table(ir, "", &cl.members));
+        body.push_str(&controllers_table(ir, "", &cl.members, None));
         files.push(crate::OutputFile {
             path: cluster_key(&folder, cl),
             contents: page(&format!("{} · {}", ir.system, cl.title), root, &body),
@@ -462,7 +462,7 @@ pub(super) fn pages(site: &Site, set: &SetDoc, svgs: &Svgs) -> Vec<crate::Output
                 );
             }
             body.push_str(&if what == "controllers" {
-                controllers_table(ir, "", chunk)
+                controllers_table(ir, "", chunk, None)
             } else {
                 buffers_table(ir, "", chunk)
             });

@@ -7,8 +7,98 @@ use super::html::{docs, esc, finding, page};
 use super::index::buffer_anchor;
 use super::plan::Placed;
 use super::{buffers_href, ctrl_page, plan_page, root_of, SetDoc, Site};
-use rcs_dsl::ir::{BufferId, CtrlId};
+use rcs_dsl::ir::{BufferId, Controller, CtrlId, Job, Target};
+use std::collections::BTreeMap;
 use std::fmt::Write;
+
+/// What the four statuses every controller has mean (statuses 0..=3).
+const BUILTIN_STATUS: [&str; 4] = [
+    "No command has arrived yet since the controller started.",
+    "A command is being carried out: its plan has not reached <code>Done</code> or <code>Error</code>.",
+    "The last command's plan reached <code>Done</code>.",
+    "The last command's plan ended in <code>Error</code>, or the command was refused; the error code says why.",
+];
+
+/// The error codes the runtime gives every controller
+/// ([`rcs_dsl::error_codes::BUILTIN`]), and when.
+const BUILTIN_ERRORS: [(&str, &str); 4] = [
+    (
+        "UNKNOWN_COMMAND",
+        "A command arrived for a verb this controller has no plan for.",
+    ),
+    (
+        "INDEX_RANGE",
+        "An index by a value fell outside its array; the plan ends here.",
+    ),
+    (
+        "HOOK_PANIC",
+        "A hand-written hook panicked; the executive caught it and ended the plan.",
+    ),
+    (
+        "REFUSED",
+        "A command's <code>accept when</code> condition was false: the command was refused.",
+    ),
+];
+
+/// The rows that report each status and end with each error code, as
+/// `(plan index, row position)`.
+struct Uses {
+    reports: BTreeMap<usize, Vec<(usize, u32)>>,
+    errors: BTreeMap<usize, Vec<(usize, u32)>>,
+}
+
+impl Uses {
+    fn of(c: &Controller) -> Uses {
+        let mut uses = Uses {
+            reports: BTreeMap::new(),
+            errors: BTreeMap::new(),
+        };
+        for (pi, plan) in c.plans.iter().enumerate() {
+            for row in &plan.rows {
+                if let Target::Error(Some(e)) = row.to {
+                    uses.errors
+                        .entry(e.index())
+                        .or_default()
+                        .push((pi, row.position));
+                }
+                for job in &row.jobs {
+                    if let Job::Report { status, error, .. } = job {
+                        let rows = uses.reports.entry(status.index()).or_default();
+                        if !rows.contains(&(pi, row.position)) {
+                            rows.push((pi, row.position));
+                        }
+                        if let Some(e) = error {
+                            uses.errors
+                                .entry(e.index())
+                                .or_default()
+                                .push((pi, row.position));
+                        }
+                    }
+                }
+            }
+        }
+        uses
+    }
+
+    /// `<p>rows reporting it: AHEAD E3, …</p>`, each row a link; nothing for none.
+    fn line(&self, what: &str, rows: Option<&Vec<(usize, u32)>>, c: &Controller) -> String {
+        let Some(rows) = rows.filter(|r| !r.is_empty()) else {
+            return String::new();
+        };
+        let links: Vec<String> = rows
+            .iter()
+            .map(|(pi, pos)| {
+                let plan = &c.plans[*pi];
+                format!(
+                    "<a href=\"{}#row-E{pos}\">{} E{pos}</a>",
+                    plan_page(c, plan),
+                    esc(&c.commands[plan.verb.index()].name)
+                )
+            })
+            .collect();
+        format!("<p class=\"uses\">{what} {}</p>\n", links.join(", "))
+    }
+}
 
 pub(super) fn controller_page(site: &Site, set: &SetDoc, ci: usize, placed: &Placed) -> String {
     let ir = set.ir;
@@ -114,20 +204,38 @@ pub(super) fn controller_page(site: &Site, set: &SetDoc, ci: usize, placed: &Pla
         s.push_str("</table>\n");
         s
     };
+    let uses = Uses::of(c);
     body.push_str(&named(
         "Statuses",
         c.statuses
             .iter()
-            .map(|s| (esc(&s.name), docs(&s.docs)))
+            .enumerate()
+            .map(|(k, s)| {
+                let about = match BUILTIN_STATUS.get(k) {
+                    Some(meaning) => format!("<p class=\"docs\">{meaning}</p>\n"),
+                    None => docs(&s.docs),
+                };
+                let by = uses.line("rows reporting it:", uses.reports.get(&k), c);
+                (esc(&s.name), format!("{about}{by}"))
+            })
             .collect(),
     ));
-    body.push_str(&named(
-        "Errors",
-        c.errors
-            .iter()
-            .map(|e| (esc(&e.name), docs(&e.docs)))
-            .collect(),
-    ));
+    let mut errors: Vec<(String, String)> = c
+        .errors
+        .iter()
+        .enumerate()
+        .map(|(k, e)| {
+            let by = uses.line("rows ending with it:", uses.errors.get(&k), c);
+            (esc(&e.name), format!("{}{by}", docs(&e.docs)))
+        })
+        .collect();
+    errors.extend(BUILTIN_ERRORS.iter().map(|(name, meaning)| {
+        (
+            format!("{name} <small>(built in)</small>"),
+            format!("<p class=\"docs\">{meaning}</p>\n"),
+        )
+    }));
+    body.push_str(&named("Errors", errors));
 
     let buffer = |b: BufferId, how: &str| {
         let buf = &ir.buffers[b.index()];

@@ -24,43 +24,49 @@ pub(super) fn page(title: &str, root: &str, body: &str) -> String {
     )
 }
 
-/// Doc comments as one paragraph (nothing when there are none).
+/// Doc comments, rendered as Markdown (nothing when there are none).
 pub(super) fn docs(lines: &[String]) -> String {
-    if lines.is_empty() {
-        return String::new();
-    }
-    format!("<p class=\"docs\">{}</p>\n", esc(&lines.join("\n")))
+    super::markdown::docs_html(lines)
 }
 
 /// A finding as the site shows it: severity, code, message, witness,
 /// notes and help.
 pub(super) fn finding(d: &Diagnostic) -> String {
+    use super::markdown::message_html;
     let mut out = format!(
         "<div class=\"finding {}\"><b>{}[{}]</b>: {}",
         d.severity.as_str(),
         d.severity.as_str(),
         d.code.name(),
-        esc(&d.message)
+        message_html(&d.message)
     );
+    // The witness once: as its own block, not also as the note that
+    // says the same for the terminal.
+    let example = d.witness.as_ref().map(|w| w.example_note());
     if let Some(w) = &d.witness {
         let inputs: Vec<String> = w
             .inputs
             .iter()
-            .map(|i| format!("{} = {}", i.name, i.value))
+            .map(|i| format!("<code>{} = {}</code>", esc(&i.name), esc(&i.value)))
             .collect();
         let _ = write!(
             out,
-            "<div class=\"witness\">witness: in state <code>{}</code>{}{}</div>",
+            "<div class=\"witness\">witness: in state <code>{}</code>{}{}{}</div>",
             esc(&w.state),
             if inputs.is_empty() { "" } else { " with " },
-            esc(&inputs.join(", "))
+            inputs.join(", "),
+            if w.run.is_some() {
+                " — <code>rcsc check --witnesses DIR</code> writes a scenario that replays it"
+            } else {
+                ""
+            }
         );
     }
-    for n in &d.notes {
-        let _ = write!(out, "<div class=\"note\">note: {}</div>", esc(n));
+    for n in d.notes.iter().filter(|n| Some(*n) != example.as_ref()) {
+        let _ = write!(out, "<div class=\"note\">note: {}</div>", message_html(n));
     }
     if let Some(h) = &d.help {
-        let _ = write!(out, "<div class=\"note\">help: {}</div>", esc(h));
+        let _ = write!(out, "<div class=\"note\">help: {}</div>", message_html(h));
     }
     out.push_str("</div>\n");
     out

@@ -7,6 +7,7 @@ use super::html::{esc, finding, page};
 use super::plan::Placed;
 use super::{buffers_href, clusters, ctrl_page, folder, hierarchy_key, plan_page, svg, Site, Svgs};
 use rcs_dsl::ir::Ir;
+use rcs_dsl::{Diagnostic, Severity};
 use std::fmt::Write;
 
 /// The anchor of a buffer in the index.
@@ -30,11 +31,17 @@ pub(super) fn index_page(site: &Site, svgs: &Svgs, placed: &[Placed]) -> String 
     if let Some(c) = &site.changes {
         body.push_str(&super::changes::index_banner(c));
     }
+    body.push_str(&contents(site));
     for (set, placed) in site.sets.iter().zip(placed) {
         let ir = set.ir;
         let folder = folder(site, set);
         let _ = writeln!(body, "<section id=\"set-{}\">", esc(&ir.system));
-        let _ = writeln!(body, "<h2>Plan set {}</h2>", esc(&ir.system));
+        let _ = writeln!(
+            body,
+            "<h2>Plan set {} {}</h2>",
+            esc(&ir.system),
+            Counts::of(set.findings.iter()).badge("")
+        );
         if let Some(r) = set.runs {
             let _ = writeln!(
                 body,
@@ -55,7 +62,7 @@ pub(super) fn index_page(site: &Site, svgs: &Svgs, placed: &[Placed]) -> String 
             body.push_str(&finding(d));
         }
         let all: Vec<usize> = (0..ir.controllers.len()).collect();
-        body.push_str(&controllers_table(ir, &folder, &all));
+        body.push_str(&controllers_table(ir, &folder, &all, Some(placed)));
         let buffers: Vec<usize> = (0..ir.buffers.len()).collect();
         body.push_str(&buffers_table(ir, &folder, &buffers));
         body.push_str("</section>\n");
@@ -63,11 +70,100 @@ pub(super) fn index_page(site: &Site, svgs: &Svgs, placed: &[Placed]) -> String 
     page("Plans", "", &body)
 }
 
+/// How many findings, by severity.
+#[derive(Default)]
+pub(super) struct Counts {
+    errors: usize,
+    warnings: usize,
+    notes: usize,
+}
+
+impl Counts {
+    pub(super) fn of<'a>(findings: impl Iterator<Item = &'a Diagnostic>) -> Counts {
+        let mut c = Counts::default();
+        for d in findings {
+            match d.severity {
+                Severity::Error => c.errors += 1,
+                Severity::Warning => c.warnings += 1,
+                Severity::Note => c.notes += 1,
+            }
+        }
+        c
+    }
+
+    /// `2 warnings · 1 note`, linked to `href` (unless empty), or a quiet
+    /// `no findings`.
+    pub(super) fn badge(&self, href: &str) -> String {
+        let mut parts = Vec::new();
+        for (n, one, class) in [
+            (self.errors, "error", "error"),
+            (self.warnings, "warning", "warning"),
+            (self.notes, "note", "note"),
+        ] {
+            if n > 0 {
+                parts.push(format!(
+                    "<span class=\"count {class}\">{n} {one}{}</span>",
+                    if n == 1 { "" } else { "s" }
+                ));
+            }
+        }
+        if parts.is_empty() {
+            return "<span class=\"count none\">no findings</span>".into();
+        }
+        let text = parts.join(" · ");
+        if href.is_empty() {
+            text
+        } else {
+            format!("<a href=\"{href}\">{text}</a>")
+        }
+    }
+}
+
+/// The table of contents at the top of the index: each plan set with its
+/// findings, and the Changes page when there is one.
+fn contents(site: &Site) -> String {
+    let mut out = String::from("<nav class=\"toc\">\n<h2>Contents</h2>\n<ul>\n");
+    for set in &site.sets {
+        let plans: usize = set.ir.controllers.iter().map(|c| c.plans.len()).sum();
+        let _ = writeln!(
+            out,
+            "<li><a href=\"#set-{0}\">{0}</a> — {1} controller{2}, {plans} plan{3} — {4}</li>",
+            esc(&set.ir.system),
+            set.ir.controllers.len(),
+            if set.ir.controllers.len() == 1 {
+                ""
+            } else {
+                "s"
+            },
+            if plans == 1 { "" } else { "s" },
+            Counts::of(set.findings.iter()).badge(&format!("#set-{}", esc(&set.ir.system)))
+        );
+    }
+    if site.changes.is_some() {
+        let _ = writeln!(
+            out,
+            "<li><a href=\"{}\">Changes</a></li>",
+            super::changes::CHANGES_PAGE
+        );
+    }
+    out.push_str("</ul>\n</nav>\n");
+    out
+}
+
 /// The table of the controllers `members` (indexes), linking to their
 /// pages through `prefix` (the set's folder, from the page).
-pub(super) fn controllers_table(ir: &Ir, prefix: &str, members: &[usize]) -> String {
+pub(super) fn controllers_table(
+    ir: &Ir,
+    prefix: &str,
+    members: &[usize],
+    counts: Option<&Placed>,
+) -> String {
     let mut out = String::new();
-    out.push_str("<h3>Controllers</h3>\n<table>\n<tr><th>controller</th><th>title</th><th>CPU</th><th>supervisor</th><th>plans</th></tr>\n");
+    out.push_str("<h3>Controllers</h3>\n<table>\n<tr><th>controller</th><th>title</th><th>CPU</th><th>supervisor</th><th>plans</th>");
+    if counts.is_some() {
+        out.push_str("<th>findings</th>");
+    }
+    out.push_str("</tr>\n");
     // With several processes, the CPU column names the process too.
     let distributed = rcs_dsl::placement::Placement::of(ir).is_distributed();
     for &ci in members {
@@ -112,9 +208,16 @@ pub(super) fn controllers_table(ir: &Ir, prefix: &str, members: &[usize]) -> Str
                 esc(&inst.ty)
             );
         }
+        let findings = match counts {
+            Some(placed) => format!(
+                "<td>{}</td>",
+                Counts::of(placed.of_controller(ci)).badge(&format!("{prefix}{}", ctrl_page(c)))
+            ),
+            None => String::new(),
+        };
         let _ = writeln!(
             out,
-            "<tr><td><a href=\"{prefix}{}\">{}</a></td><td>{}</td><td>{}</td><td>{sup}</td><td>{}</td></tr>",
+            "<tr><td><a href=\"{prefix}{}\">{}</a></td><td>{}</td><td>{}</td><td>{sup}</td><td>{}</td>{findings}</tr>",
             ctrl_page(c),
             esc(&c.name),
             title,

@@ -28,6 +28,7 @@ mod clusters;
 mod controller;
 mod html;
 mod index;
+mod markdown;
 mod plan;
 pub mod runs;
 mod svg;

@@ -26,6 +26,22 @@ pub(super) struct Placed<'a> {
     pub rows: BTreeMap<(usize, usize, usize), Vec<&'a Diagnostic>>,
 }
 
+impl<'a> Placed<'a> {
+    /// Every finding placed on controller `ci`: on it, its plans and rows.
+    pub(super) fn of_controller(&self, ci: usize) -> impl Iterator<Item = &'a Diagnostic> + '_ {
+        let on = self.ctrls.get(&ci).into_iter().flatten();
+        let plans = self
+            .plans
+            .range((ci, 0)..(ci + 1, 0))
+            .flat_map(|(_, v)| v.iter());
+        let rows = self
+            .rows
+            .range((ci, 0, 0)..(ci + 1, 0, 0))
+            .flat_map(|(_, v)| v.iter());
+        on.chain(plans).chain(rows).copied()
+    }
+}
+
 fn inside(outer: Span, inner: Span) -> bool {
     outer.file == inner.file
         && outer.start <= inner.start
@@ -169,6 +185,13 @@ fn states(
             names.push(terminal.to_string());
         }
     }
+    let row_link = |r: &rcs_dsl::ir::Row| {
+        format!(
+            "<a href=\"#row-{}\">{}</a>",
+            r.display_name(),
+            esc(&p.label(r))
+        )
+    };
     for (i, name) in names.iter().enumerate() {
         let _ = write!(body, "<li id=\"state-{}\"><b>{}</b>", esc(name), esc(name));
         if let Some(node) = nodes.get(name) {
@@ -190,16 +213,35 @@ fn states(
             .rows
             .iter()
             .filter(|r| r.from.names(StateId(i as u32)))
-            .map(|r| {
-                format!(
-                    "<a href=\"#row-{}\">{}</a>",
-                    r.display_name(),
-                    esc(&p.label(r))
-                )
-            })
+            .map(row_link)
             .collect();
         if !from.is_empty() {
             let _ = write!(body, " — rows: {}", from.join(" "));
+        }
+        if i == 0 && !nodes.contains_key(name) {
+            // S0 is where every command starts; the graph draws the rows
+            // that leave it as their own `*N` nodes (or from the states
+            // they name), so S0 has no circle: say so where it is listed.
+            let entry: Vec<String> = plan
+                .rows
+                .iter()
+                .filter(|r| r.is_entry && r.from.applies_in(StateId(0)))
+                .map(row_link)
+                .collect();
+            let _ = write!(
+                body,
+                " — where every command starts; not drawn as a state: {}",
+                if entry.is_empty() {
+                    "the rows that apply in every state leave it".to_string()
+                } else {
+                    format!(
+                        "the entry row{} {} leave{} it",
+                        if entry.len() == 1 { "" } else { "s" },
+                        entry.join(" "),
+                        if entry.len() == 1 { "s" } else { "" }
+                    )
+                }
+            );
         }
         body.push_str("</li>\n");
     }

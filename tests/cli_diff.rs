@@ -67,11 +67,11 @@ fn a_reordered_plan_draws_its_move() {
     assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
     let dot = std::fs::read_to_string(graphs.join("TANK.FILL.dot")).unwrap();
     assert!(
-        dot.contains("\"E5 otherwise\" [label=<+ E5 otherwise<BR/>"),
+        dot.contains("\"E5 otherwise\" [label=\"+E5 otherwise\""),
         "{dot}"
     );
     assert!(
-        dot.contains("shape=note, style=dashed, color=darkgreen"),
+        dot.contains("shape=note, style=dashed, fontsize=11, color=darkgreen"),
         "{dot}"
     );
     let _ = std::fs::remove_dir_all(&dir);
@@ -228,7 +228,7 @@ fn state_sets_are_shown_as_written_and_drawn_per_state() {
     assert!(shown.contains("from: * → * except Holding"), "{shown}");
     let dot = std::fs::read_to_string(graphs.join("CELL.RUN.dot")).unwrap();
     for from in ["Starting", "Execute"] {
-        let edge = format!("\"{from}\" -> \"Holding\" [label=<<FONT COLOR=\"darkorange\">~ E2:");
+        let edge = format!("\"{from}\" -> \"Holding\" [label=<<TABLE BORDER=\"0\" CELLBORDER=\"0\" CELLSPACING=\"0\" CELLPADDING=\"3\"><TR><TD><FONT COLOR=\"darkorange\">~E2</FONT>");
         assert!(dot.contains(&edge), "{edge}\n{dot}");
     }
     assert!(dot.contains("\"*5\" -> \"Error\""), "{dot}");

@@ -3,18 +3,26 @@
 //!
 //! Notation (Figure 13, Appendix C): states are circles, `Done` a double
 //! circle, `Error` a red octagon; each don't-care row gets its own dashed
-//! `*N` pseudo-node with an edge to its target (an `except` row's node
-//! says `except A, B` under its name), and a row of a state set `A | B` is
-//! an edge from each of its states. Rows between the same two
-//! nodes (several self-loops on one state, say) are **one edge** whose
-//! label lists them, one line per row (`EN: condition`, its jobs in a
-//! smaller line under it), and a loop of several rows hangs below its
-//! state with its label under it, so no arc crosses a label; an edge's label is
-//! tied to its arc (`decorate`) where several edges enter one node, so a
-//! fan-in label cannot be read as another edge's. The `otherwise` row is
-//! not an edge of any state: it is a dashed note, `EN otherwise`, saying
-//! what happens in any state when no row matches (an edge from the note
-//! when it leaves the state). Nodes appear in the order of the rows.
+//! `*N` pseudo-node with an edge to its target, and a row of a state set
+//! `A | B` is an edge from each of its states. Rows between the same two
+//! nodes (several self-loops on one state, say) are **one edge**. The
+//! `otherwise` row is not an edge of any state: it is a dashed note,
+//! `EN otherwise` (an edge from the note when it leaves the state). Nodes
+//! appear in the order of the rows.
+//!
+//! **A layout that cannot collide** (issue 29). An edge is labelled with
+//! its rows' names only (`E3`, `E3 E4`), in one font size; the rows'
+//! state patterns, targets, conditions and jobs are in the state table
+//! under the drawing ([`legend`]), which is the graph's own label, wrapped
+//! to a bounded width, and so part of the SVG with space of its own. What
+//! runs every cycle (status fields, `pre`/`post`) and when a command is
+//! accepted are lines under that table, not notes in the drawing. Short
+//! labels are what Graphviz places without overlap: long multi-line labels
+//! (and loops hung from ports) were what made them run into each other
+//! and under `*N` nodes. A graph whose chain of states is too long for a
+//! page drawn left to right is drawn top to bottom ([`rankdir`]), so the
+//! site does not shrink its text. No text is smaller than 11 pt. The test
+//! `tests/graph_layout/` renders every graph and checks all of this.
 //!
 //! Every node and edge carries an `id`, first among its attributes, that
 //! names what it draws whatever the layout: `node-<state>`
@@ -23,14 +31,28 @@
 //! several rows, `ctrl-<name>` in the hierarchy. Graphviz copies them into
 //! SVG; the doc site keys its links on them (see [`node_id`], [`edge_id`]).
 //!
-//! [`Edge`] and [`edge_attrs`] are shared with the diff graphs
-//! (`crate::diff_dot`), which colour each line by what a change did to it.
+//! [`Edge`], [`write_edge`] and the [`legend`] are shared with the diff
+//! graphs (`crate::diff_dot`), which colour each name by what a change did
+//! to its row.
+
+pub(crate) mod legend;
 
 use crate::GENERATED;
+use legend::TableRow;
 use rcs_dsl::ir::{Controller, Cpu, From, Ir, Plan, Row, Target};
 use rcs_dsl::placement::Placement;
 use rcs_dsl::pretty::Printer;
 use std::fmt::Write;
+
+/// The text size of edge labels, notes and the state table, in points:
+/// 14.7 px at full size, still 10 px when the site shrinks a graph to
+/// 68% to fit its page.
+pub(crate) const SMALL_FONT: u32 = 11;
+/// How wide, in points, a graph may be before its text would fall under
+/// 10 px on the site's page (1,200 px wide: `site.css`, at a 1,280-px
+/// window): 11 pt is 10 px at 68%, 1,200 px / 0.68 = 1,765 px = 1,323 pt;
+/// with room to spare for what the estimate in [`rankdir`] misses.
+pub(crate) const PAGE_POINTS: usize = 1000;
 
 /// Escape text for a Graphviz HTML-like label.
 pub(crate) fn html(s: &str) -> String {
@@ -74,18 +96,16 @@ pub(crate) fn header(out: &mut String, source: &str) {
     let _ = writeln!(out, "// {GENERATED} from {source}. Do not edit.");
 }
 
-/// One row as a line of an edge label.
+/// One row as a name on an edge.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Line {
     /// The row's name (`E2`), for the edge's `id`; empty for none.
     pub(crate) row: String,
-    /// `E2: TB.done && x > 1`.
-    pub(crate) text: String,
-    /// The job list, `;`-separated; empty for none.
-    pub(crate) jobs: String,
-    /// Where the row is, or its doc comment.
+    /// What the edge shows for the row: `E2` (in a diff, `+E2`).
+    pub(crate) name: String,
+    /// The row in full and where it is, or its doc comment.
     pub(crate) tooltip: String,
-    /// A font colour for the line (diff graphs); `None`: the default.
+    /// A font colour for the name (diff graphs); `None`: the default.
     pub(crate) color: Option<&'static str>,
 }
 
@@ -114,34 +134,34 @@ pub(crate) fn merge_edges(rows: impl IntoIterator<Item = (String, String, Line)>
     edges
 }
 
-/// The attributes of an edge: its label (one left-aligned line per row,
-/// the jobs in a smaller line under it) and tooltip; `decorate` ties the
-/// label to its arc when other edges enter the same node.
-fn edge_attrs(edge: &Edge, all: &[Edge]) -> String {
+/// Names per line of an edge label: `E1 E2 E3 E4`, then the next line.
+const NAMES_PER_LINE: usize = 4;
+
+/// The attributes of an edge: its `id` (`id="edge-E3", `, or empty), its
+/// label (its rows' names, four to a line: `label=<…>`) and its tooltip
+/// (each row in full: `tooltip="…"`).
+fn edge_attrs(edge: &Edge) -> (String, String, String) {
     let mut label = String::new();
-    // One row: its line, its jobs centred under it. Several: every line
-    // left-aligned, the jobs indented under their row.
-    let (br, indent) = match edge.lines.len() {
-        1 => ("<BR/>", ""),
-        _ => ("<BR ALIGN=\"LEFT\"/>", "   "),
-    };
-    for line in &edge.lines {
-        let (open, close) = match line.color {
-            Some(c) => (format!("<FONT COLOR=\"{c}\">"), "</FONT>"),
-            None => (String::new(), ""),
-        };
-        let _ = write!(label, "{open}{}{close}", html(&line.text));
-        if !line.jobs.is_empty() {
-            let _ = write!(
-                label,
-                "{br}<FONT POINT-SIZE=\"8\">{open}{indent}{}{close}</FONT>",
-                html(&line.jobs)
-            );
+    for (i, line) in edge.lines.iter().enumerate() {
+        if i > 0 {
+            label.push_str(if i % NAMES_PER_LINE == 0 {
+                "<BR/>"
+            } else {
+                " "
+            });
         }
-        if edge.lines.len() > 1 {
-            label.push_str(br);
+        match line.color {
+            Some(c) => {
+                let _ = write!(label, "<FONT COLOR=\"{c}\">{}</FONT>", html(&line.name));
+            }
+            None => label.push_str(&html(&line.name)),
         }
     }
+    // A borderless cell around the names keeps a margin between them and
+    // any line: Graphviz places an edge's label box touching its edge.
+    let label = format!(
+        "<TABLE BORDER=\"0\" CELLBORDER=\"0\" CELLSPACING=\"0\" CELLPADDING=\"3\"><TR><TD>{label}</TD></TR></TABLE>"
+    );
     let tips: Vec<&str> = edge.lines.iter().map(|l| l.tooltip.as_str()).collect();
     let rows: Vec<String> = edge.lines.iter().map(|l| l.row.clone()).collect();
     let id = if rows.iter().any(String::is_empty) {
@@ -149,20 +169,17 @@ fn edge_attrs(edge: &Edge, all: &[Edge]) -> String {
     } else {
         format!("id={}, ", quoted(&edge_id(&rows)))
     };
-    let mut attrs = format!("{id}label=<{label}>, tooltip={}", quoted(&tips.join("\n")));
-    let fan_in = all
-        .iter()
-        .filter(|e| e.to == edge.to && e.from != e.to)
-        .count();
-    if edge.from != edge.to && fan_in > 1 {
-        attrs.push_str(", decorate=true");
-    }
-    attrs
+    (
+        id,
+        format!("label=<{label}>"),
+        format!("tooltip={}", quoted(&tips.join("\n"))),
+    )
 }
 
 /// The nodes a row leaves from: its state, each state of its set (one
 /// edge per state, every one labelled with the row), or its own `*N`
-/// pseudo-node (an `except` row's says which states it leaves out).
+/// pseudo-node (an `except` row's too; the table says which states it
+/// leaves out).
 pub(crate) fn from_nodes(p: &Printer, r: &Row) -> Vec<String> {
     match &r.from {
         From::DontCare(_) | From::Except(..) => vec![format!("*{}", r.position)],
@@ -181,33 +198,35 @@ pub(crate) fn to_node(p: &Printer, r: &Row, from: &str) -> String {
     }
 }
 
-/// The attributes of the `*N` node of an `except` row: dashed, labelled
-/// `*N` over `except A, B`.
-fn except_node_attrs(p: &Printer, r: &Row) -> Option<String> {
-    let From::Except(_, out) = &r.from else {
-        return None;
+/// A row's line of the state table.
+fn table_row(p: &Printer, r: &Row) -> TableRow {
+    let from = match &r.from {
+        _ if r.is_otherwise() => "any (no row matched)".to_string(),
+        From::DontCare(_) => "*".to_string(),
+        From::State(s) => p.state(*s),
+        From::States(set) => p.states(set),
+        From::Except(_, out) => format!("* except {}", p.states(out)),
     };
-    let names: Vec<String> = out.iter().map(|s| p.state(*s)).collect();
-    let label = format!(
-        "*{}<BR/><FONT POINT-SIZE=\"8\">except {}</FONT>",
-        r.position,
-        html(&names.join(", "))
-    );
-    Some(format!("label=<{label}>, style=dashed"))
+    TableRow {
+        name: p.label(r),
+        from,
+        to: p.target(r),
+        condition: if r.is_otherwise() {
+            "otherwise".to_string()
+        } else {
+            p.condition(r)
+        },
+        jobs: r.jobs.iter().map(|j| p.job(j)).collect(),
+        color: None,
+    }
 }
 
-/// A row's line: `E2: condition` (`→ Error(E)` added when it names one).
-pub(crate) fn row_line(ir: &Ir, p: &Printer, r: &Row) -> Line {
-    let mut text = format!("{}: {}", p.label(r), p.condition(r));
-    if let Target::Error(Some(_)) = r.to {
-        text.push_str(&format!(" → {}", p.target(r)));
-    }
-    let jobs: Vec<String> = r.jobs.iter().map(|j| p.job(j)).collect();
+/// A row's name on its edge, its tooltip the row in full.
+fn row_line(ir: &Ir, p: &Printer, r: &Row) -> Line {
     Line {
         row: r.display_name(),
-        text,
-        jobs: jobs.join("; "),
-        tooltip: tooltip(ir, r),
+        name: p.label(r),
+        tooltip: format!("{}: {}\n{}", p.label(r), p.condition(r), tooltip(ir, r)),
         color: None,
     }
 }
@@ -226,27 +245,6 @@ pub fn otherwise_name(r: &Row) -> String {
     format!("{} otherwise", r.display_name())
 }
 
-/// The label of the `otherwise` note: what it does, in any state.
-pub(crate) fn otherwise_label(p: &Printer, r: &Row) -> String {
-    let mut label = format!(
-        "{}<BR/><FONT POINT-SIZE=\"8\">any state, no row matched",
-        html(&otherwise_name(r))
-    );
-    if matches!(r.to, Target::Same) {
-        label.push_str(": stay");
-    }
-    label.push_str("</FONT>");
-    if !r.jobs.is_empty() {
-        let jobs: Vec<String> = r.jobs.iter().map(|j| p.job(j)).collect();
-        let _ = write!(
-            label,
-            "<BR/><FONT POINT-SIZE=\"8\">{}</FONT>",
-            html(&jobs.join("; "))
-        );
-    }
-    label
-}
-
 /// The attributes of a node that is not a plain state.
 pub(crate) fn node_attrs(id: &str) -> String {
     match id {
@@ -257,88 +255,94 @@ pub(crate) fn node_attrs(id: &str) -> String {
     }
 }
 
+/// `LR` (states left to right, as the methodology draws them) unless the
+/// longest chain of states would make the drawing wider than a page, then
+/// `TB`. A node's rank is estimated as its distance from the nodes no edge
+/// enters (the `*N` nodes, the first state); a rank across takes about
+/// 110 pt left to right (a circle, a short label, the space between), a
+/// node about 80 pt side by side top to bottom.
+pub(crate) fn rankdir(nodes: &[String], edges: &[Edge]) -> &'static str {
+    let index = |n: &str| nodes.iter().position(|m| m == n);
+    let entered: Vec<bool> = nodes
+        .iter()
+        .map(|n| edges.iter().any(|e| e.to == *n && e.from != e.to))
+        .collect();
+    let mut depth: Vec<Option<usize>> = vec![None; nodes.len()];
+    let mut queue: std::collections::VecDeque<usize> =
+        (0..nodes.len()).filter(|i| !entered[*i]).collect();
+    if queue.is_empty() && !nodes.is_empty() {
+        queue.push_back(0);
+    }
+    for i in &queue {
+        depth[*i] = Some(0);
+    }
+    while let Some(i) = queue.pop_front() {
+        let d = depth[i].unwrap_or(0);
+        for e in edges.iter().filter(|e| e.from == nodes[i]) {
+            if let Some(j) = index(&e.to).filter(|j| depth[*j].is_none()) {
+                depth[j] = Some(d + 1);
+                queue.push_back(j);
+            }
+        }
+    }
+    let ranks = depth.iter().flatten().max().map_or(1, |d| d + 1);
+    let mut widest = 1;
+    for d in 0..ranks {
+        widest = widest.max(depth.iter().filter(|x| **x == Some(d)).count());
+    }
+    if ranks * 110 > PAGE_POINTS && widest * 80 < ranks * 110 {
+        "TB"
+    } else {
+        "LR"
+    }
+}
+
 /// The state graph of one plan.
 pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
     let p = Printer::new(ir, ctrl, Some(plan));
     let verb = &ctrl.commands[plan.verb.index()].name;
     let source = &ir.files[plan.header.file.0 as usize];
-    let mut out = String::new();
-    header(&mut out, source);
-    let title = format!("{} · {}", ctrl.name, ctrl.plan_title(plan));
-    graph_head(
-        &mut out,
-        &format!("{}.{verb}", ctrl.name),
-        &title,
-        &plan.docs,
-    );
+    let mut notes = Vec::new();
     // Status fields and `pre`/`post` jobs: what runs every cycle, beside the plan.
     if let Some(note) = crate::every_cycle::note(ir, ctrl) {
-        let _ = writeln!(
-            out,
-            "    \"every cycle\" [shape=note, fontsize=10, label=<{}>];",
-            html(&note)
-        );
+        notes.push(note);
     }
-
     // Refusal (step 3a): when a command of the plan's verbs is taken.
-    let accepts: Vec<String> = plan
-        .verbs
-        .iter()
-        .filter_map(|v| {
-            let k = &ctrl.commands[v.index()];
-            let a = k.accept.as_ref()?;
-            Some(format!("{} accepted only when {}", k.name, p.expr(&a.cond)))
-        })
-        .collect();
-    if !accepts.is_empty() {
-        let _ = writeln!(
-            out,
-            "    \"accept\" [shape=note, fontsize=10, label=<{}>];",
-            accepts
-                .iter()
-                .map(|a| html(a))
-                .collect::<Vec<_>>()
-                .join("<br/>")
-        );
+    for v in &plan.verbs {
+        let k = &ctrl.commands[v.index()];
+        if let Some(a) = k.accept.as_ref() {
+            notes.push(format!("{} accepted only when {}", k.name, p.expr(&a.cond)));
+        }
     }
 
     // Nodes in order of first appearance in the rows.
-    let mut emitted: Vec<String> = Vec::new();
-    let mut node = |out: &mut String, id: String, r: &Row| {
-        if !emitted.contains(&id) {
-            let attrs = match except_node_attrs(&p, r).filter(|_| id.starts_with('*')) {
-                Some(a) => a,
-                None => node_attrs(&id),
-            };
-            let sep = if attrs.is_empty() { "" } else { ", " };
-            let _ = writeln!(
-                out,
-                "    {} [id={}{sep}{attrs}];",
-                quoted(&id),
-                quoted(&node_id(&id))
-            );
-            emitted.push(id);
+    let mut nodes: Vec<(String, String)> = Vec::new();
+    let mut node = |id: String, attrs: String| {
+        if !nodes.iter().any(|(n, _)| *n == id) {
+            nodes.push((id, attrs));
         }
     };
     let mut edges = Vec::new();
+    let mut extra = String::new();
     for r in &plan.rows {
         if r.is_otherwise() {
             let note = otherwise_name(r);
-            let _ = writeln!(
-                out,
-                "    {} [id={}, label=<{}>, shape=note, style=dashed, tooltip={}];",
-                quoted(&note),
-                quoted(&node_id(&format!("*{}", r.position))),
-                otherwise_label(&p, r),
-                quoted(&tooltip(ir, r))
+            let to = to_node(&p, r, "");
+            node(
+                note.clone(),
+                format!(
+                    "id={}, shape=note, style=dashed, fontsize={SMALL_FONT}, tooltip={}",
+                    quoted(&node_id(&format!("*{}", r.position))),
+                    quoted(&tooltip(ir, r))
+                ),
             );
             if !matches!(r.to, Target::Same) {
-                node(&mut out, to_node(&p, r, ""), r);
+                node(to.clone(), String::new());
                 let _ = writeln!(
-                    out,
+                    extra,
                     "    {} -> {} [id={}, style=dashed];",
                     quoted(&note),
-                    quoted(&to_node(&p, r, "")),
+                    quoted(&to),
                     quoted(&edge_id(&[r.display_name()]))
                 );
             }
@@ -346,37 +350,68 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
         }
         for from in from_nodes(&p, r) {
             let to = to_node(&p, r, &from);
-            node(&mut out, from.clone(), r);
-            node(&mut out, to.clone(), r);
+            node(from.clone(), String::new());
+            node(to.clone(), String::new());
             edges.push((from, to, row_line(ir, &p, r)));
         }
     }
     let edges = merge_edges(edges);
+    let names: Vec<String> = nodes.iter().map(|(n, _)| n.clone()).collect();
+
+    let mut out = String::new();
+    header(&mut out, source);
+    let title = format!("{} · {}", ctrl.name, ctrl.plan_title(plan));
+    let rows: Vec<TableRow> = plan.rows.iter().map(|r| table_row(&p, r)).collect();
+    graph_head(
+        &mut out,
+        &format!("{}.{verb}", ctrl.name),
+        &plan.docs,
+        rankdir(&names, &edges),
+        &legend::table(&title, &rows, &notes),
+    );
+    for (id, attrs) in &nodes {
+        let attrs = if attrs.is_empty() {
+            let plain = node_attrs(id);
+            let sep = if plain.is_empty() { "" } else { ", " };
+            format!("id={}{sep}{plain}", quoted(&node_id(id)))
+        } else {
+            attrs.clone()
+        };
+        let _ = writeln!(out, "    {} [{attrs}];", quoted(id));
+    }
+    out.push_str(&extra);
     for e in &edges {
-        write_edge(&mut out, e, &edges, "");
+        write_edge(&mut out, e, "");
     }
     out.push_str("}\n");
     out
 }
 
-/// One edge. A self-loop of several rows hangs below its node (`:s`
-/// ports), where its label sits under the arc: in the default place, with
-/// `rankdir=LR`, Graphviz lets the arc run through a label of many lines.
-/// A loop of one row keeps the default place, which leaves more room.
-/// `extra` attributes follow the label's (`, color=red`).
-pub(crate) fn write_edge(out: &mut String, e: &Edge, all: &[Edge], extra: &str) {
-    let port = if e.from == e.to && e.lines.len() > 1 {
-        ":s"
-    } else {
-        ""
-    };
+/// One edge; `extra` attributes follow the label's (`, color=red`).
+///
+/// A self-loop is drawn through its label: the label is a node of its own
+/// (`loop S1`, plain text) with a line from the state to it and an arrow
+/// back. Graphviz places a loop's own label after routing the other edges,
+/// so another edge may run through it; a node, it routes around.
+pub(crate) fn write_edge(out: &mut String, e: &Edge, extra: &str) {
+    let (id, label, tooltip) = edge_attrs(e);
+    let from = quoted(&e.from);
+    if e.from != e.to {
+        let to = quoted(&e.to);
+        let _ = writeln!(out, "    {from} -> {to} [{id}{label}, {tooltip}{extra}];");
+        return;
+    }
+    let node = quoted(&format!("loop {}", e.from));
     let _ = writeln!(
         out,
-        "    {}{port} -> {}{port} [{}{extra}];",
-        quoted(&e.from),
-        quoted(&e.to),
-        edge_attrs(e, all)
+        "    {node} [shape=plaintext, fontsize={SMALL_FONT}, {label}];"
     );
+    let _ = writeln!(
+        out,
+        "    {from} -> {node} [{id}{tooltip}, arrowhead=none{extra}];"
+    );
+    // The way back has no `id`: the SVG would hold it twice.
+    let _ = writeln!(out, "    {node} -> {from} [{tooltip}{extra}];");
 }
 
 /// The `id` of the node named `name` in a plan graph: `node-<state>`, or
@@ -399,17 +434,26 @@ pub fn ctrl_id(name: &str) -> String {
     format!("ctrl-{name}")
 }
 
-/// `digraph NAME {` and the graph, node and edge defaults.
-pub(crate) fn graph_head(out: &mut String, name: &str, title: &str, docs: &[String]) {
+/// `digraph NAME {`, the graph's label (the state table, at the
+/// bottom), and the graph, node and edge defaults.
+pub(crate) fn graph_head(
+    out: &mut String,
+    name: &str,
+    docs: &[String],
+    rankdir: &str,
+    label: &str,
+) {
     let _ = writeln!(out, "digraph {} {{", quoted(name));
     let _ = writeln!(
         out,
-        "    graph [label={}, labelloc=t, rankdir=LR, fontname=\"Helvetica\", tooltip={}];",
-        quoted(title),
+        "    graph [label=<{label}>, labelloc=b, rankdir={rankdir}, pad=0.3, nodesep=0.4, ranksep=0.5, fontname=\"Helvetica\", fontsize={SMALL_FONT}, tooltip={}];",
         quoted(&docs.join("\n"))
     );
     out.push_str("    node [fontname=\"Helvetica\", shape=circle];\n");
-    out.push_str("    edge [fontname=\"Helvetica\", fontsize=10];\n");
+    let _ = writeln!(
+        out,
+        "    edge [fontname=\"Helvetica\", fontsize={SMALL_FONT}];"
+    );
 }
 /// The controller tree, one cluster per executive ("CPU"), inside one
 /// cluster per process when the manifest places CPUs in several.
@@ -419,7 +463,7 @@ pub fn hierarchy_graph(ir: &Ir) -> String {
     let _ = writeln!(out, "digraph {} {{", quoted(&ir.system));
     let _ = writeln!(
         out,
-        "    graph [label={}, labelloc=t, fontname=\"Helvetica\", rankdir=TB];",
+        "    graph [label={}, labelloc=t, fontname=\"Helvetica\", rankdir=TB, pad=0.3];",
         quoted(&format!("{} hierarchy", ir.system))
     );
     out.push_str("    node [fontname=\"Helvetica\", shape=box, style=rounded];\n");
@@ -435,9 +479,11 @@ pub fn hierarchy_graph(ir: &Ir) -> String {
                 "    subgraph {} {{",
                 quoted(&format!("cluster_process_{p}"))
             );
+            out.push_str("        style=solid;\n");
             let _ = writeln!(
                 out,
-                "        label={}; style=solid; fontname=\"Helvetica\";",
+                "        {} [shape=plaintext, label={}];",
+                quoted(&format!("process_label_{p}")),
                 quoted(&format!("process {process}"))
             );
         }
@@ -448,6 +494,14 @@ pub fn hierarchy_graph(ir: &Ir) -> String {
             .filter(|(i, _)| placement.cpu_process.get(*i) == Some(&p));
         for (i, cpu) in cpus {
             cpu_cluster(&mut out, ir, indent, i, cpu);
+            if distributed {
+                let _ = writeln!(
+                    out,
+                    "        {} -> {} [style=invis];",
+                    quoted(&format!("process_label_{p}")),
+                    quoted(&format!("cpu_label_{i}"))
+                );
+            }
         }
         if distributed {
             out.push_str("    }\n");
@@ -475,26 +529,50 @@ fn cpu_cluster(out: &mut String, ir: &Ir, indent: &str, i: usize, cpu: &Cpu) {
         "{indent}    subgraph {} {{",
         quoted(&format!("cluster_{i}"))
     );
+    // The cluster's name is a node above its controllers (an invisible
+    // edge to each keeps it there), not the cluster's label: Graphviz
+    // routes edges around nodes, but through a cluster's label.
+    let _ = writeln!(out, "{indent}        style=dashed;");
+    let label = quoted(&format!("cpu_label_{i}"));
     let _ = writeln!(
         out,
-        "{indent}        label={}; style=dashed; fontname=\"Helvetica\";",
+        "{indent}        {label} [shape=plaintext, label={}];",
         quoted(&format!("CPU {} · {}", cpu.name, period(cpu.period_ns)))
     );
     for c in &cpu.order {
         let ctrl = ir.controller(*c);
-        let mut label = html(&ctrl.name);
+        // One cell per line: lines of different sizes in one cell touch.
+        let mut label = format!(
+            "<TABLE BORDER=\"0\" CELLSPACING=\"0\" CELLPADDING=\"1\"><TR><TD>{}</TD></TR>",
+            html(&ctrl.name)
+        );
         if let Some(t) = ctrl.title.as_ref().filter(|t| !t.is_empty()) {
-            let _ = write!(label, "<BR/><FONT POINT-SIZE=\"9\">{}</FONT>", html(t));
+            let _ = write!(
+                label,
+                "<TR><TD><FONT POINT-SIZE=\"{SMALL_FONT}\">{}</FONT></TD></TR>",
+                html(t)
+            );
         }
         if let Some(l) = ctrl.level {
-            let _ = write!(label, "<BR/><FONT POINT-SIZE=\"8\">level {l}</FONT>");
+            let _ = write!(
+                label,
+                "<TR><TD><FONT POINT-SIZE=\"{SMALL_FONT}\">level {l}</FONT></TD></TR>"
+            );
         }
+        label.push_str("</TABLE>");
         let _ = writeln!(
             out,
             "{indent}        {} [id={}, label=<{label}>, tooltip={}];",
             quoted(&ctrl.name),
             quoted(&ctrl_id(&ctrl.name)),
             quoted(&ctrl.docs.join("\n"))
+        );
+    }
+    for c in &cpu.order {
+        let _ = writeln!(
+            out,
+            "{indent}        {label} -> {} [style=invis];",
+            quoted(&ir.controller(*c).name)
         );
     }
     let _ = writeln!(out, "{indent}    }}");

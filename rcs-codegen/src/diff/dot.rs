@@ -4,8 +4,14 @@
 //! its row — added green, removed red, changed orange, moved in precedence
 //! marked `⇅` — and each edge coloured by its rows (red and dashed when all
 //! of them were removed). States added are green, removed red and dashed.
+//! As in a plan graph, an edge shows its rows' names (with their change
+//! sign, `+E5`) and the rows in full are in the state table under the
+//! drawing, each line in its row's colour, the key to the signs under it.
 
-use crate::dot::{graph_head, html, merge_edges, node_attrs, quoted, write_edge, Line};
+use crate::dot::legend::{self, TableRow};
+use crate::dot::{
+    graph_head, merge_edges, node_attrs, quoted, rankdir, write_edge, Line, SMALL_FONT,
+};
 use rcs_dsl::diff::{PlanDiff, RowChange, RowDiff};
 use std::fmt::Write;
 
@@ -33,7 +39,6 @@ pub fn diff_dot(plan: &PlanDiff, source: &str) -> String {
         plan.name()
     );
     let name = plan.name();
-    graph_head(&mut out, &name, &name.replacen('.', " · ", 1), &[]);
     let moved: Vec<&str> = plan
         .moves
         .iter()
@@ -42,6 +47,7 @@ pub fn diff_dot(plan: &PlanDiff, source: &str) -> String {
     let mut nodes: Vec<String> = Vec::new();
     let mut edges = Vec::new();
     let mut notes = Vec::new();
+    let mut rows = Vec::new();
     for r in &plan.rows {
         let Some(v) = r.new.as_ref().or(r.old.as_ref()) else {
             continue;
@@ -61,16 +67,23 @@ pub fn diff_dot(plan: &PlanDiff, source: &str) -> String {
         if let (RowChange::Changed(_), Some(o)) = (&r.change, &r.old) {
             tooltip.push_str(&format!("\nwas: {}", o.text()));
         }
-        let sep = if v.otherwise { " " } else { ": " };
-        let mut text = format!("{mark}{sign}{}{sep}{}", v.label, v.condition);
-        if v.target.starts_with("Error(") {
-            text.push_str(&format!(" → {}", v.target));
-        }
+        rows.push(TableRow {
+            name: format!("{mark}{sign}{}", v.label),
+            from: if v.otherwise {
+                "any (no row matched)".to_string()
+            } else {
+                v.from.clone()
+            },
+            to: v.target.clone(),
+            condition: v.condition.clone(),
+            jobs: v.jobs.clone(),
+            color: color(r),
+        });
+        tooltip = format!("{}\n{tooltip}", v.text());
         // No ids: a row may stand on both sides of a diff under one name.
         let line = Line {
             row: String::new(),
-            text,
-            jobs: v.jobs.join("; "),
+            name: format!("{mark}{}{}", sign.trim_end(), v.label),
             tooltip,
             color: color(r),
         };
@@ -95,6 +108,15 @@ pub fn diff_dot(plan: &PlanDiff, source: &str) -> String {
             edges.push((from, to, line.clone()));
         }
     }
+    let edges = merge_edges(edges);
+    let key = "+ added · − removed · ~ changed · ⇅ moved in precedence".to_string();
+    graph_head(
+        &mut out,
+        &name,
+        &[],
+        rankdir(&nodes, &edges),
+        &legend::table(&name.replacen('.', " · ", 1), &rows, &[key]),
+    );
     for n in &nodes {
         let mut attrs = node_attrs(n);
         if plan.states_added.contains(n) {
@@ -108,9 +130,9 @@ pub fn diff_dot(plan: &PlanDiff, source: &str) -> String {
         let c = line.color.unwrap_or("black");
         let _ = writeln!(
             out,
-            "    {} [label=<{}>, shape=note, style=dashed, color={c}, fontcolor={c}, tooltip={}];",
+            "    {} [label={}, shape=note, style=dashed, fontsize={SMALL_FONT}, color={c}, fontcolor={c}, tooltip={}];",
             quoted(id),
-            note_label(line),
+            quoted(&format!("{} otherwise", line.name)),
             quoted(&line.tooltip)
         );
         if let Some(to) = to {
@@ -122,7 +144,6 @@ pub fn diff_dot(plan: &PlanDiff, source: &str) -> String {
             );
         }
     }
-    let edges = merge_edges(edges);
     for e in &edges {
         let colors: Vec<Option<&str>> = e.lines.iter().map(|l| l.color).collect();
         let mut attrs = String::new();
@@ -135,30 +156,11 @@ pub fn diff_dot(plan: &PlanDiff, source: &str) -> String {
         } else if colors.iter().any(Option::is_some) {
             let _ = write!(attrs, ", color={ORANGE}");
         }
-        if e.lines.iter().any(|l| l.text.starts_with('⇅')) {
+        if e.lines.iter().any(|l| l.name.starts_with('⇅')) {
             attrs.push_str(", penwidth=2");
         }
-        write_edge(&mut out, e, &edges, &attrs);
+        write_edge(&mut out, e, &attrs);
     }
-    let legend = "+ added · − removed · ~ changed · ⇅ moved in precedence";
-    let _ = writeln!(
-        out,
-        "    legend [shape=plaintext, label=<<FONT POINT-SIZE=\"9\">{}</FONT>>];",
-        html(legend)
-    );
     out.push_str("}\n");
     out
-}
-
-/// An `otherwise` note's label: its line, its jobs under it.
-fn note_label(line: &Line) -> String {
-    let mut label = html(&line.text);
-    if !line.jobs.is_empty() {
-        let _ = write!(
-            label,
-            "<BR/><FONT POINT-SIZE=\"8\">{}</FONT>",
-            html(&line.jobs)
-        );
-    }
-    label
 }

@@ -297,8 +297,81 @@ pub(crate) fn rankdir(nodes: &[String], edges: &[Edge]) -> &'static str {
     }
 }
 
+/// What the doc site marks on a plan's graph, by row name (`E2`): how
+/// many cycles fired each row (`--coverage`, `--trace`), and the rows with
+/// a finding, by severity (`error`, `warning`, `note`).
+#[derive(Clone, Debug, Default)]
+pub struct RowMarks {
+    pub hits: Option<std::collections::BTreeMap<String, u64>>,
+    pub findings: std::collections::BTreeMap<String, &'static str>,
+}
+
+impl RowMarks {
+    /// A row's name as its edge shows it: `E2`, with `⚠` after a row with
+    /// a finding; red when it never fired or has an error, orange for a
+    /// warning. The hit counts go in the state table beside the name (on
+    /// the edge, a long label is what Graphviz cannot keep clear of lines).
+    fn mark(&self, line: &mut Line) {
+        if let Some(color) = self.color(&line.row) {
+            line.color = Some(color);
+        }
+        if self.findings.contains_key(&line.row) {
+            line.name.push_str(" ⚠");
+        }
+    }
+
+    /// The row's name in the state table: `E2 ×12 ⚠`.
+    fn mark_table(&self, key: &str, row: &mut TableRow) {
+        if let Some(n) = self.hits.as_ref().map(|h| h.get(key).copied().unwrap_or(0)) {
+            row.name = format!("{} ×{}", row.name, compact(n));
+        }
+        if self.findings.contains_key(key) {
+            row.name.push_str(" ⚠");
+        }
+        if let Some(color) = self.color(key) {
+            row.color = Some(color);
+        }
+    }
+
+    fn color(&self, row: &str) -> Option<&'static str> {
+        match self.findings.get(row) {
+            Some(&"error") => return Some("#b00000"),
+            Some(_) => return Some("#b06000"),
+            None => {}
+        }
+        let never = self
+            .hits
+            .as_ref()
+            .is_some_and(|h| h.get(row).copied().unwrap_or(0) == 0);
+        never.then_some("#b00000")
+    }
+}
+
+/// A count in at most four characters: `7`, `950`, `12k`, `2.5M`, `3G`.
+fn compact(n: u64) -> String {
+    const UNITS: [(u64, &str); 3] = [(1_000_000_000, "G"), (1_000_000, "M"), (1_000, "k")];
+    for (unit, suffix) in UNITS {
+        if n >= unit {
+            let whole = n / unit;
+            return if whole < 10 {
+                // One decimal, rounded down: never more than it was.
+                format!("{whole}.{}{suffix}", (n % unit) * 10 / unit)
+            } else {
+                format!("{whole}{suffix}")
+            };
+        }
+    }
+    n.to_string()
+}
+
 /// The state graph of one plan.
 pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
+    plan_graph_marked(ir, ctrl, plan, &RowMarks::default())
+}
+
+/// The state graph of one plan with each row's name marked (hits,
+/// findings) as [`RowMarks`] says: what the doc site draws.
+pub fn plan_graph_marked(ir: &Ir, ctrl: &Controller, plan: &Plan, marks: &RowMarks) -> String {
     let p = Printer::new(ir, ctrl, Some(plan));
     let verb = &ctrl.commands[plan.verb.index()].name;
     let source = &ir.files[plan.header.file.0 as usize];
@@ -352,7 +425,9 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
             let to = to_node(&p, r, &from);
             node(from.clone(), String::new());
             node(to.clone(), String::new());
-            edges.push((from, to, row_line(ir, &p, r)));
+            let mut line = row_line(ir, &p, r);
+            marks.mark(&mut line);
+            edges.push((from, to, line));
         }
     }
     let edges = merge_edges(edges);
@@ -361,7 +436,15 @@ pub fn plan_graph(ir: &Ir, ctrl: &Controller, plan: &Plan) -> String {
     let mut out = String::new();
     header(&mut out, source);
     let title = format!("{} · {}", ctrl.name, ctrl.plan_title(plan));
-    let rows: Vec<TableRow> = plan.rows.iter().map(|r| table_row(&p, r)).collect();
+    let rows: Vec<TableRow> = plan
+        .rows
+        .iter()
+        .map(|r| {
+            let mut row = table_row(&p, r);
+            marks.mark_table(&r.display_name(), &mut row);
+            row
+        })
+        .collect();
     graph_head(
         &mut out,
         &format!("{}.{verb}", ctrl.name),
@@ -588,5 +671,21 @@ pub fn period(ns: u64) -> String {
         format!("{} µs", ns / 1_000)
     } else {
         format!("{ns} ns")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn counts_are_compact_and_never_rounded_up() {
+        let c = super::compact;
+        assert_eq!(c(0), "0");
+        assert_eq!(c(999), "999");
+        assert_eq!(c(1_000), "1.0k");
+        assert_eq!(c(1_999), "1.9k");
+        assert_eq!(c(12_345), "12k");
+        assert_eq!(c(2_469_134), "2.4M");
+        assert_eq!(c(999_999_999), "999M");
+        assert_eq!(c(u64::MAX), "18446744073G");
     }
 }

@@ -185,6 +185,48 @@ fn every_plan_and_hierarchy_of_plans_is_legible() {
     check_all("plans", &graphs);
 }
 
+/// As the doc site draws them with `--coverage`/`--trace` and findings:
+/// every row's name followed by its hits (some never fired, some in the
+/// millions) and a mark on rows with a finding.
+#[test]
+fn marked_graphs_of_plans_are_legible() {
+    if !tools::dot_available("the layout of the marked graphs of plans/") {
+        return;
+    }
+    let mut graphs = Vec::new();
+    for path in entries("plans") {
+        for set in rcs_dsl::load_paths(std::slice::from_ref(&path)).expect("loads") {
+            let ir = rcs_dsl::check(&set, &rcs_dsl::Options::default())
+                .ir
+                .expect("checks");
+            for ctrl in &ir.controllers {
+                for plan in &ctrl.plans {
+                    let mut marks = rcs_codegen::dot::RowMarks::default();
+                    let hits = plan
+                        .rows
+                        .iter()
+                        .map(|r| (r.display_name(), u64::from(r.position % 3) * 1_234_567))
+                        .collect();
+                    marks.hits = Some(hits);
+                    for r in plan.rows.iter().filter(|r| r.position % 2 == 1) {
+                        marks.findings.insert(r.display_name(), "warning");
+                    }
+                    graphs.push(Graph {
+                        name: format!(
+                            "{} {}.{} marked",
+                            path.display(),
+                            ctrl.name,
+                            ctrl.plan_title(plan)
+                        ),
+                        dot: rcs_codegen::dot::plan_graph_marked(&ir, ctrl, plan, &marks),
+                    });
+                }
+            }
+        }
+    }
+    check_all("plans marked", &graphs);
+}
+
 #[test]
 fn every_graph_of_the_golden_ok_cases_is_legible() {
     if !tools::dot_available("the layout of the graphs of tests/data/ok/") {

@@ -119,10 +119,15 @@ pub fn graphs(site: &Site) -> Vec<GraphSource> {
                 dot: svg::link_hierarchy(&crate::dot::hierarchy_graph(set.ir), &folder),
             });
         }
-        for ctrl in &set.ir.controllers {
-            for plan in &ctrl.plans {
-                let dot = crate::dot::plan_graph(set.ir, ctrl, plan);
+        let placed = plan::place_findings(set);
+        for (ci, ctrl) in set.ir.controllers.iter().enumerate() {
+            for (pi, plan) in ctrl.plans.iter().enumerate() {
                 let weights = set.runs.map(|r| r.row_weights(&ctrl.name, plan));
+                let marks = crate::dot::RowMarks {
+                    hits: weights.clone(),
+                    findings: placed.row_severities(ci, pi, plan),
+                };
+                let dot = crate::dot::plan_graph_marked(set.ir, ctrl, plan, &marks);
                 out.push(GraphSource {
                     key: plan_key(&folder, ctrl, plan),
                     dot: svg::link_plan(&dot, weights.as_ref()),

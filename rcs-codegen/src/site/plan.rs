@@ -27,6 +27,31 @@ pub(super) struct Placed<'a> {
 }
 
 impl<'a> Placed<'a> {
+    /// The rows of plan `pi` of controller `ci` with a finding, by name,
+    /// each with the most severe finding's severity.
+    pub(super) fn row_severities(
+        &self,
+        ci: usize,
+        pi: usize,
+        plan: &rcs_dsl::ir::Plan,
+    ) -> BTreeMap<String, &'static str> {
+        let mut out = BTreeMap::new();
+        for ((_, _, ri), ds) in self.rows.range((ci, pi, 0)..(ci, pi + 1, 0)) {
+            let Some(row) = plan.rows.get(*ri) else {
+                continue;
+            };
+            let worst = ds.iter().map(|d| d.severity).min_by_key(|s| match s {
+                rcs_dsl::Severity::Error => 0,
+                rcs_dsl::Severity::Warning => 1,
+                rcs_dsl::Severity::Note => 2,
+            });
+            if let Some(sev) = worst {
+                out.insert(row.display_name(), sev.as_str());
+            }
+        }
+        out
+    }
+
     /// Every finding placed on controller `ci`: on it, its plans and rows.
     pub(super) fn of_controller(&self, ci: usize) -> impl Iterator<Item = &'a Diagnostic> + '_ {
         let on = self.ctrls.get(&ci).into_iter().flatten();

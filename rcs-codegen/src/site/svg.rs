@@ -61,7 +61,15 @@ pub(super) fn link_plan(dot: &str, weights: Option<&BTreeMap<String, u64>>) -> S
         let first = rows.first()?;
         let mut attrs = format!(", URL=\"#row-{first}\"");
         if let Some(w) = weights {
-            let hits: u64 = rows.iter().filter_map(|r| w.get(*r)).sum();
+            // An edge is as heavy as its busiest row, never more: a shared
+            // edge whose other rows never fired is not drawn as if they had
+            // (each row's own count is on the edge's label).
+            let hits: u64 = rows
+                .iter()
+                .filter_map(|r| w.get(*r))
+                .copied()
+                .max()
+                .unwrap_or(0);
             if hits == 0 {
                 attrs.push_str(", class=\"never\"");
             } else {

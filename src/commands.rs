@@ -257,7 +257,7 @@ pub(crate) fn graph(args: GraphArgs) -> ExitCode {
 /// before that), so that the next `rcsc graph -o` may replace it.
 fn mark_svg(svg: &str) -> String {
     let mark = format!(
-        "<!-- {} by `rcsc graph`. Do not edit. -->",
+        "<!-- {} (`rcsc graph`). Do not edit. -->",
         rcs_codegen::GENERATED
     );
     match svg.split_once('\n') {
@@ -332,7 +332,7 @@ pub(crate) fn ir(args: IrArgs) -> ExitCode {
 /// comments, a `"//"` member opening the object (of the first object, for
 /// a list of plan sets), which readers of the IR ignore.
 fn mark_ir(format: IrFormat, text: String) -> String {
-    let about = format!("{} by `rcsc ir`. Do not edit.", rcs_codegen::GENERATED);
+    let about = format!("{} (`rcsc ir`). Do not edit.", rcs_codegen::GENERATED);
     match format {
         IrFormat::Yaml => format!("# {about}\n{text}"),
         IrFormat::Json => {

@@ -299,6 +299,20 @@ fn control_characters_from_the_plans_reach_no_terminal() {
             assert!(all.contains(r"\u{1b}]0;owned\u{7}\u{1b}[2J"), "{all}");
         }
     }
+    // A manifest's process name, quoted in a message (YAML's `\e` is ESC).
+    let plan = "controller A {\n    command GO\n    plan GO {\n        *0 when new_command -> Done\n    }\n}\n";
+    let manifest = "system: s\nschedule:\n  - cpu: c1\n    period: 30ms\n    order: [A]\n    process: \"he\\e[2Jlm\"\n";
+    let set = dir.join("q");
+    std::fs::create_dir_all(&set).unwrap();
+    std::fs::write(set.join("a.rcs"), plan).unwrap();
+    std::fs::write(set.join("rcs.yaml"), manifest).unwrap();
+    for format in ["human", "short"] {
+        let out = rcsc(&["check", s(&set), "--message-format", format]);
+        assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+        let err = text(&out.stderr);
+        assert!(!err.contains('\u{1b}'), "{err:?}");
+        assert!(err.contains(r"process name `he\u{1b}[2Jlm`"), "{err}");
+    }
     // A controller name from a trace file, summed by `rcsc trace`.
     let trace = dir.join("t.jsonl");
     std::fs::write(

@@ -143,7 +143,7 @@ pub(crate) fn build(args: BuildArgs) -> ExitCode {
     };
     let report = match rcs_codegen::writer::write_tree(&args.out_dir, &files, &mut blocked) {
         Ok(report) => report,
-        Err(e) => return fail(e),
+        Err(e) => return write_failed(&e),
     };
     let mut message = format!(
         "{} ({} changed",

@@ -19,13 +19,11 @@ pub(crate) fn fail(reason: impl std::fmt::Display) -> ExitCode {
 }
 
 /// A write the writer refused or that failed: exit 2 with
-/// `error[code]: why` and, for a refusal, a `help:` line.
+/// `error[code]: why` (`error: why` for an I/O error) and, for most
+/// refusals, a `help:` line.
 pub(crate) fn write_failed(e: &rcs_codegen::writer::WriteError) -> ExitCode {
-    eprintln!(
-        "error[{}]: {}",
-        e.code(),
-        render::escape_controls(&e.to_string())
-    );
+    let code = e.code().map(|c| format!("[{c}]")).unwrap_or_default();
+    eprintln!("error{code}: {}", render::escape_controls(&e.to_string()));
     if let Some(help) = e.help() {
         eprintln!("  = help: {help}");
     }

@@ -126,8 +126,9 @@ pub enum WriteError {
     )]
     NotGenerated(Vec<String>),
     #[error(
-        "refusing to overwrite `{path}`: it is `{input}`, a file this command reads; \
-         nothing was written"
+        "refusing to overwrite `{path}`: it is {}a file this command reads (a plan, a \
+         manifest or a scenario); nothing was written",
+        if .path == .input { String::new() } else { format!("`{}`, ", .input) }
     )]
     Input { path: String, input: String },
     #[error("{path}: {source}")]
@@ -135,9 +136,10 @@ pub enum WriteError {
 }
 
 impl WriteError {
-    /// A short name for the kind of refusal, as a diagnostic's code.
-    pub fn code(&self) -> &'static str {
-        match self {
+    /// A short name for the kind of refusal, as a diagnostic's code;
+    /// `None` for an I/O error, which is no refusal.
+    pub fn code(&self) -> Option<&'static str> {
+        Some(match self {
             WriteError::OutsideOutput(_) => "outside_output",
             WriteError::Reserved(_) => "reserved_path",
             WriteError::Collision(..) => "path_collision",
@@ -145,16 +147,16 @@ impl WriteError {
             WriteError::InTheWay { .. } => "in_the_way",
             WriteError::NotGenerated(_) => "not_generated",
             WriteError::Input { .. } => "overwrites_input",
-            WriteError::Io { .. } => "io",
-        }
+            WriteError::Io { .. } => return None,
+        })
     }
 
     /// What the user can do about a refusal.
     pub fn help(&self) -> Option<&'static str> {
         match self {
             WriteError::NotGenerated(_) => Some(
-                "move the file away (or remove it) if rcsc may replace it, or write to another \
-                 path (for a build, rename the plans or choose another output folder)",
+                "move or remove it if rcsc may replace it, or write to another path (another \
+                 output folder, for a build)",
             ),
             WriteError::Input { .. } => Some("choose another output path"),
             WriteError::InTheWay { .. } | WriteError::Symlink { .. } => {

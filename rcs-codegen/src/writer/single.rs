@@ -135,12 +135,11 @@ pub fn write_file(
             why: "it names a folder, not a file",
         });
     }
-    // A link is followed: the file replaced is the one it names, in its folder.
-    let target = match std::fs::read_link(path) {
-        Ok(to) if std::fs::metadata(path).is_ok() => match path.parent() {
-            Some(dir) => dir.join(to),
-            None => to,
-        },
+    // A link is followed (through any chain of links): the file replaced
+    // is the one it names, in its folder.
+    let is_link = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+    let target = match std::fs::canonicalize(path) {
+        Ok(real) if is_link => real,
         _ => path.to_path_buf(),
     };
     let name = target

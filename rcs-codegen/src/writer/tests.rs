@@ -433,7 +433,7 @@ fn one_named_file_follows_the_rules_of_a_build() {
     std::fs::write(&out, "mine\n").unwrap();
     let err = write_file(&out, &body, &inputs, &mut quiet).unwrap_err();
     assert!(matches!(err, WriteError::NotGenerated(_)), "{err}");
-    assert_eq!(err.code(), "not_generated");
+    assert_eq!(err.code(), Some("not_generated"));
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "mine\n");
     let err = write_file(&inputs_dir, &body, &Inputs::new(), &mut quiet).unwrap_err();
     assert!(matches!(err, WriteError::InTheWay { .. }), "{err}");

@@ -68,13 +68,17 @@ pub(crate) fn certs(args: CertsArgs) -> ExitCode {
     let hosts: Vec<&str> = args.hosts.iter().map(String::as_str).collect();
     match rcs_runtime::acl::certs::make_dev_certs(&args.dir, &names, &hosts) {
         Ok(made) => {
+            // Process names come from the manifests, the folder from the
+            // user: no control character of theirs reaches the terminal.
+            let shown = rcs_dsl::render::escape_controls;
             let dir = rcs_dsl::load::display(&args.dir);
+            let dir = shown(&dir);
             if made.new_ca {
                 println!("made a development CA in {dir} (keep ca.key off the plant network)");
             } else {
                 println!("reused the CA in {dir}");
             }
-            println!("certificates for: {}", names.join(", "));
+            println!("certificates for: {}", shown(&names.join(", ")));
             ExitCode::SUCCESS
         }
         Err(e) => fail(e),

@@ -28,7 +28,7 @@ pub(crate) fn check(args: CheckArgs) -> ExitCode {
             eprintln!(
                 "wrote {} to {}",
                 plural(found.len(), "witness scenario"),
-                rcs_dsl::load::display(dir)
+                rcs_dsl::render::escape_controls(&rcs_dsl::load::display(dir))
             );
         }
     }
@@ -143,7 +143,7 @@ pub(crate) fn build(args: BuildArgs) -> ExitCode {
     };
     let report = match rcs_codegen::writer::write_tree(&args.out_dir, &files, &mut blocked) {
         Ok(report) => report,
-        Err(e) => return fail(e),
+        Err(e) => return write_failed(&e),
     };
     let mut message = format!(
         "{} ({} changed",
@@ -241,14 +241,29 @@ pub(crate) fn graph(args: GraphArgs) -> ExitCode {
             }
         },
     };
-    let bytes = match args.format {
-        GraphFormat::Dot => dot.into_bytes(),
+    let text = match args.format {
+        GraphFormat::Dot => dot,
         GraphFormat::Svg => match render_svg(&dot) {
-            Ok(svg) => svg,
+            Ok(svg) => mark_svg(&String::from_utf8_lossy(&svg)),
             Err(reason) => return fail(reason),
         },
     };
-    emit(args.out.as_deref(), &bytes)
+    let inputs = inputs_of(irs.iter().map(|(set, _)| set));
+    emit(args.out.as_deref(), &text, &inputs)
+}
+
+/// Graphviz's SVG with the generated marker in its first line (an XML
+/// comment, after the XML declaration when there is one: nothing may come
+/// before that), so that the next `rcsc graph -o` may replace it.
+fn mark_svg(svg: &str) -> String {
+    let mark = format!(
+        "<!-- {} (`rcsc graph`). Do not edit. -->",
+        rcs_codegen::GENERATED
+    );
+    match svg.split_once('\n') {
+        Some((first, rest)) if first.starts_with("<?xml") => format!("{first}{mark}\n{rest}"),
+        _ => format!("{mark}\n{svg}"),
+    }
 }
 
 /// DOT → SVG through Graphviz `dot`, the one program the CLI runs.
@@ -293,6 +308,7 @@ pub(crate) fn ir(args: IrArgs) -> ExitCode {
         Ok(irs) => irs,
         Err(code) => return code,
     };
+    let inputs = inputs_of(irs.iter().map(|(set, _)| set));
     let irs: Vec<&rcs_dsl::ir::Ir> = irs.iter().map(|(_, ir)| ir).collect();
     let text = match (args.format, irs.as_slice()) {
         (IrFormat::Json, [one]) => serde_json::to_string_pretty(one).map_err(|e| e.to_string()),
@@ -305,8 +321,29 @@ pub(crate) fn ir(args: IrArgs) -> ExitCode {
             if !text.ends_with('\n') {
                 text.push('\n');
             }
-            emit(args.out.as_deref(), text.as_bytes())
+            emit(args.out.as_deref(), &mark_ir(args.format, text), &inputs)
         }
         Err(e) => fail(format!("cannot serialise the IR: {e}")),
+    }
+}
+
+/// The IR with the generated marker in its first line, so that the next
+/// `rcsc ir -o` may replace it: a YAML comment; in JSON, which has no
+/// comments, a `"//"` member opening the object (of the first object, for
+/// a list of plan sets), which readers of the IR ignore.
+fn mark_ir(format: IrFormat, text: String) -> String {
+    let about = format!("{} (`rcsc ir`). Do not edit.", rcs_codegen::GENERATED);
+    match format {
+        IrFormat::Yaml => format!("# {about}\n{text}"),
+        IrFormat::Json => {
+            let member = format!("{{\"//\": \"{about}\",\n");
+            if let Some(rest) = text.strip_prefix("{\n") {
+                format!("{member}{rest}")
+            } else if let Some(rest) = text.strip_prefix("[\n  {\n") {
+                format!("[{member}{rest}")
+            } else {
+                text
+            }
+        }
     }
 }

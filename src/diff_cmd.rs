@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
 
 use crate::args::{ColorChoice, DiffArgs, DiffFormat};
-use crate::output::{default_paths, emit, fail};
+use crate::output::{default_paths, emit, fail, inputs_of, write_failed};
 
 /// Where one side's plans are.
 enum Where {
@@ -104,14 +104,19 @@ fn run(args: &DiffArgs) -> Result<ExitCode, String> {
     drop(temps);
 
     if let Some(dir) = &args.graphs {
-        write_graphs(dir, &diff, &format!("{}..{}", old.name(), new.name()))?;
+        // A revision's files were in a temporary folder, gone by now.
+        let inputs = inputs_of(old_sets.iter().chain(&new_sets));
+        let source = format!("{}..{}", old.name(), new.name());
+        if let Err(e) = write_graphs(dir, &diff, &source, &inputs) {
+            return Ok(write_failed(&e));
+        }
     }
     let text = match args.format {
         DiffFormat::Text => rcs_codegen::diff::text(&diff, color(args.common.color)),
         DiffFormat::Markdown => rcs_codegen::diff::markdown(&diff),
         DiffFormat::Json => serde_json::to_string_pretty(&diff).map_err(|e| e.to_string())? + "\n",
     };
-    let code = emit(None, text.as_bytes());
+    let code = emit(None, &text, &Default::default());
     if code != ExitCode::SUCCESS {
         return Ok(code);
     }
@@ -288,22 +293,32 @@ fn color(choice: ColorChoice) -> bool {
 }
 
 /// One DOT file per changed plan: `DIR/CTRL.VERB.dot`, under
-/// `DIR/<system>/` when several systems changed.
-fn write_graphs(dir: &Path, diff: &PlanSetDiff, source: &str) -> Result<(), String> {
+/// `DIR/<system>/` when several systems changed; written through the one
+/// writer (no file of the plans read is replaced, nor any file rcsc did
+/// not generate).
+fn write_graphs(
+    dir: &Path,
+    diff: &PlanSetDiff,
+    source: &str,
+    inputs: &rcs_codegen::writer::Inputs,
+) -> Result<(), rcs_codegen::writer::WriteError> {
     let several = diff.systems.len() > 1;
+    let mut files = Vec::new();
     for s in &diff.systems {
-        let folder = if several {
-            dir.join(&s.name)
-        } else {
-            dir.to_path_buf()
-        };
         for p in s.controllers.iter().flat_map(|c| &c.plans) {
-            std::fs::create_dir_all(&folder)
-                .map_err(|e| format!("cannot create {}: {e}", folder.display()))?;
-            let path = folder.join(format!("{}.dot", p.name()));
-            std::fs::write(&path, rcs_codegen::diff::diff_dot(p, source))
-                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            let name = format!("{}.dot", p.name());
+            files.push(rcs_codegen::OutputFile {
+                path: if several {
+                    format!("{}/{name}", s.name)
+                } else {
+                    name
+                },
+                contents: rcs_codegen::diff::diff_dot(p, source),
+            });
         }
     }
-    Ok(())
+    if files.is_empty() {
+        return Ok(());
+    }
+    rcs_codegen::writer::write_files_sparing(dir, &files, inputs, &mut |_| {}).map(|_| ())
 }

@@ -174,7 +174,7 @@ pub(crate) fn doc(args: DocArgs) -> ExitCode {
     };
     let report = match rcs_codegen::writer::write_tree(&args.out_dir, &files, &mut blocked) {
         Ok(r) => r,
-        Err(e) => return fail(e),
+        Err(e) => return write_failed(&e),
     };
     status.line(
         "Generating",

@@ -1,6 +1,10 @@
 //! What the subcommands print and how they end: diagnostics and their
-//! summary, cargo-like status lines, writing to a file or stdout, and
-//! exit statuses.
+//! summary, cargo-like status lines, writing to a file (through the one
+//! writer's rules, [`rcs_codegen::writer`]) or stdout, and exit statuses.
+//!
+//! Text that came from the user (paths, names, messages) may hold control
+//! characters; every failure line goes through [`rcs_dsl::render::escape_controls`]
+//! so that none reaches a terminal as itself.
 
 use crate::args::*;
 use rcs_dsl::render::{self, Format};
@@ -10,8 +14,33 @@ use std::process::ExitCode;
 
 /// A failure outside the plans: exit 2 with one line.
 pub(crate) fn fail(reason: impl std::fmt::Display) -> ExitCode {
-    eprintln!("error: {reason}");
+    eprintln!("error: {}", render::escape_controls(&reason.to_string()));
     ExitCode::from(2)
+}
+
+/// A write the writer refused or that failed: exit 2 with
+/// `error[code]: why` (`error: why` for an I/O error) and, for most
+/// refusals, a `help:` line.
+pub(crate) fn write_failed(e: &rcs_codegen::writer::WriteError) -> ExitCode {
+    let code = e.code().map(|c| format!("[{c}]")).unwrap_or_default();
+    eprintln!("error{code}: {}", render::escape_controls(&e.to_string()));
+    if let Some(help) = e.help() {
+        eprintln!("  = help: {help}");
+    }
+    ExitCode::from(2)
+}
+
+/// The files of `sets` (plans and manifests): no output may replace one.
+pub(crate) fn inputs_of<'a>(
+    sets: impl IntoIterator<Item = &'a rcs_dsl::PlanSet>,
+) -> rcs_codegen::writer::Inputs {
+    let mut inputs = rcs_codegen::writer::Inputs::new();
+    for set in sets {
+        for (_, f) in set.sources.files() {
+            inputs.add(std::path::Path::new(&f.path));
+        }
+    }
+    inputs
 }
 
 pub(crate) fn default_paths(paths: Vec<PathBuf>) -> Vec<PathBuf> {
@@ -84,6 +113,7 @@ impl Status {
         if self.quiet {
             return;
         }
+        let message = render::escape_controls(&message.to_string()).into_owned();
         if self.color {
             let pad = " ".repeat(12usize.saturating_sub(verb.chars().count()));
             eprintln!("{pad}\x1b[1m\x1b[32m{verb}\x1b[0m {message}");
@@ -105,22 +135,29 @@ pub(crate) fn set_name(set: &rcs_dsl::PlanSet) -> &str {
         .map_or(set.name.as_str(), |(s, _)| s.as_str())
 }
 
-/// Write a command's product to `out` (a file) or to stdout.
-pub(crate) fn emit(out: Option<&std::path::Path>, bytes: &[u8]) -> ExitCode {
-    let result = match out {
-        Some(path) => std::fs::write(path, bytes)
-            .map_err(|e| format!("cannot write {}: {e}", rcs_dsl::load::display(path))),
-        None => {
-            let mut stdout = std::io::stdout().lock();
-            match stdout.write_all(bytes).and_then(|()| stdout.flush()) {
-                // A closed pipe (`rcsc ir | head`) is the reader's choice, not a failure.
-                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-                r => r.map_err(|e| format!("cannot write to stdout: {e}")),
-            }
+/// Write a command's product to `out` (a file, through the writer: it
+/// must carry [`rcs_codegen::GENERATED`] in its first line, and may replace
+/// neither a file of `inputs` nor one rcsc did not generate) or to stdout.
+pub(crate) fn emit(
+    out: Option<&std::path::Path>,
+    text: &str,
+    inputs: &rcs_codegen::writer::Inputs,
+) -> ExitCode {
+    if let Some(path) = out {
+        return match rcs_codegen::writer::write_file(path, text, inputs, &mut |_| {}) {
+            Ok(_) => ExitCode::SUCCESS,
+            Err(e) => write_failed(&e),
+        };
+    }
+    let mut stdout = std::io::stdout().lock();
+    match stdout
+        .write_all(text.as_bytes())
+        .and_then(|()| stdout.flush())
+    {
+        // A closed pipe (`rcsc ir | head`) is the reader's choice, not a failure.
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            fail(format!("cannot write to stdout: {e}"))
         }
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(reason) => fail(reason),
+        _ => ExitCode::SUCCESS,
     }
 }

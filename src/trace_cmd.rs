@@ -88,5 +88,8 @@ pub(crate) fn trace(args: TraceArgs) -> ExitCode {
     for (_, ir) in &irs {
         text.push_str(&counts.summary(Some(ir)));
     }
-    emit(None, text.as_bytes())
+    // Controller names come from the trace files: no control character
+    // of theirs reaches the terminal.
+    let text = rcs_dsl::render::escape_controls(&text);
+    emit(None, &text, &Default::default())
 }

@@ -47,11 +47,28 @@ pub const BOM: char = '\u{FEFF}';
 
 /// One input file: its display path (relative to the plan set's root, with
 /// `/` separators) and its text.
+///
+/// Positions come from two indexes built once with the file: where each
+/// line starts, and (for a text that is not all ASCII) how many characters
+/// come before every [`CHAR_BLOCK`]-byte block. A column is then found in
+/// a bounded time however long its line is: 100,000 diagnostics on one
+/// long line cost what they cost one per line.
 #[derive(Clone, Debug)]
 pub struct SourceFile {
     pub path: String,
     pub text: String,
     line_starts: Vec<usize>,
+    /// Characters before byte `i * CHAR_BLOCK`, for each block; empty when
+    /// the text is ASCII (a character is then a byte).
+    chars_before_block: Vec<u32>,
+}
+
+/// The bytes of a block of the character index.
+const CHAR_BLOCK: usize = 64;
+
+/// Whether a byte starts a character (is not a UTF-8 continuation byte).
+fn starts_char(b: &u8) -> bool {
+    (*b as i8) >= -0x40
 }
 
 impl SourceFile {
@@ -70,11 +87,42 @@ impl SourceFile {
                 ends_line.then_some(i + 1)
             }))
             .collect();
+        let chars_before_block = if text.is_ascii() {
+            Vec::new()
+        } else {
+            let mut before = 0u32;
+            text.as_bytes()
+                .chunks(CHAR_BLOCK)
+                .map(|block| {
+                    let at = before;
+                    before += block.iter().filter(|b| starts_char(b)).count() as u32;
+                    at
+                })
+                .collect()
+        };
         SourceFile {
             path: path.into(),
             text,
             line_starts,
+            chars_before_block,
         }
+    }
+
+    /// How many characters start before byte `offset` (`offset <= len`).
+    fn chars_before(&self, offset: usize) -> usize {
+        if self.chars_before_block.is_empty() {
+            return offset;
+        }
+        let block = offset / CHAR_BLOCK;
+        let from = block * CHAR_BLOCK;
+        let within = self.text.as_bytes()[from..offset]
+            .iter()
+            .filter(|b| starts_char(b))
+            .count();
+        self.chars_before_block
+            .get(block)
+            .map_or(0, |&n| n as usize)
+            + within
     }
 
     /// 1-based line and column (in characters) of a byte offset.
@@ -89,7 +137,7 @@ impl SourceFile {
         while !self.text.is_char_boundary(col_end) {
             col_end -= 1;
         }
-        let column = self.text[start..col_end].chars().count() + 1;
+        let column = self.chars_before(col_end) - self.chars_before(start) + 1;
         (line + 1, column)
     }
 
@@ -151,6 +199,25 @@ mod tests {
         // `e` is on line 6, column 1; the `d`s on line 4.
         assert_eq!(f.line_col(16), (6, 1));
         assert_eq!(f.line_col(12), (4, 3));
+    }
+
+    #[test]
+    fn columns_count_characters_on_long_and_short_lines() {
+        // Every offset of a mixed text, against counting the characters.
+        let line = "aé€😀b".repeat(40);
+        let text = format!("{line}\nx\u{1b}ü\n{line}");
+        let f = SourceFile::new("t", text.clone());
+        for offset in 0..=text.len() {
+            let mut end = offset;
+            while !text.is_char_boundary(end) {
+                end -= 1;
+            }
+            let start = text[..end].rfind('\n').map_or(0, |i| i + 1);
+            let want = text[start..end].chars().count() + 1;
+            assert_eq!(f.line_col(offset).1, want, "offset {offset}");
+        }
+        let ascii = SourceFile::new("t", "abc\ndef");
+        assert_eq!(ascii.line_col(7), (2, 4));
     }
 
     #[test]

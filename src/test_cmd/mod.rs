@@ -45,6 +45,50 @@ impl Backend {
     }
 }
 
+/// Text from the plans, scenarios and paths, for the terminal.
+fn shown(text: &str) -> std::borrow::Cow<'_, str> {
+    rcs_dsl::render::escape_controls(text)
+}
+
+/// The header of `rcsc test --trace`: the generated marker in the first
+/// line lets the next run replace the file.
+fn trace_header() -> rcs_runtime::TraceHeader {
+    rcs_runtime::TraceHeader {
+        generated: Some(format!("{} test --trace", rcs_codegen::GENERATED)),
+        ..rcs_runtime::TraceHeader::current()
+    }
+}
+
+/// The bytes of a trace being written, shared with the sink (which owns
+/// its writer).
+#[derive(Clone, Default)]
+struct TraceBuffer(std::sync::Arc<std::sync::Mutex<Vec<u8>>>);
+
+impl TraceBuffer {
+    /// The trace so far, as text (records are JSON: always UTF-8).
+    fn take(&self) -> String {
+        let bytes = match self.0.lock() {
+            Ok(mut b) => std::mem::take(&mut *b),
+            Err(poisoned) => std::mem::take(&mut *poisoned.into_inner()),
+        };
+        String::from_utf8_lossy(&bytes).into_owned()
+    }
+}
+
+impl std::io::Write for TraceBuffer {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        match self.0.lock() {
+            Ok(mut b) => b.extend_from_slice(buf),
+            Err(poisoned) => poisoned.into_inner().extend_from_slice(buf),
+        }
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
 /// Print a status line through the CLI's `Status`.
 pub fn status_fn(status: &Status) -> impl Fn(&str) + '_ {
     move |m| status.line("Compiling", m)
@@ -69,6 +113,20 @@ pub(crate) fn test(args: TestArgs) -> ExitCode {
         Ok(irs) => irs,
         Err(code) => return code,
     };
+    // The files read (plans, manifests, scenarios): the trace replaces none.
+    let mut inputs = inputs_of(&sets);
+    for p in &targets.scenarios {
+        inputs.add(p);
+    }
+    for p in per_set.iter().flatten() {
+        inputs.add(p);
+    }
+    // Refuse a trace path the writer would refuse before running anything.
+    if let Some(path) = &args.trace {
+        if let Err(e) = rcs_codegen::writer::check_file(path, &inputs) {
+            return write_failed(&e);
+        }
+    }
     // A run that tests nothing is a mistake (a wrong path, a misnamed
     // folder), not a success.
     if per_set.iter().all(Vec::is_empty) {
@@ -78,7 +136,7 @@ pub(crate) fn test(args: TestArgs) -> ExitCode {
             .collect();
         eprintln!(
             "error: no scenarios to run (looked in {}); write `*.scenario.yaml` files there or name them",
-            looked.join(", ")
+            shown(&looked.join(", "))
         );
         return ExitCode::from(1);
     }
@@ -87,8 +145,8 @@ pub(crate) fn test(args: TestArgs) -> ExitCode {
         for ((set, ir), _) in untested.filter(|(_, files)| files.is_empty()) {
             eprintln!(
                 "warning: plan set `{}` has no scenarios (none under {}/scenarios/)",
-                ir.system,
-                set.root.trim_end_matches('/')
+                shown(&ir.system),
+                shown(set.root.trim_end_matches('/'))
             );
         }
     }
@@ -112,18 +170,12 @@ pub(crate) fn test(args: TestArgs) -> ExitCode {
         }
     }
 
-    let mut trace = match &args.trace {
-        None => None,
-        Some(path) => match std::fs::File::create(path) {
-            Ok(f) => Some(TraceSink::new(std::io::BufWriter::new(f))),
-            Err(e) => {
-                return fail(format!(
-                    "cannot write the trace {}: {e}",
-                    rcs_dsl::load::display(path)
-                ))
-            }
-        },
-    };
+    // The trace is gathered in memory and written whole, through the writer.
+    let trace_bytes = TraceBuffer::default();
+    let mut trace = args
+        .trace
+        .as_ref()
+        .map(|_| TraceSink::with_header(trace_bytes.clone(), &trace_header()));
     let (mut passed, mut failed) = (0, 0);
     let mut reports = Vec::new();
     let mut coverage_text = String::new();
@@ -149,11 +201,11 @@ pub(crate) fn test(args: TestArgs) -> ExitCode {
             match r.failure {
                 None => {
                     passed += 1;
-                    println!("test {} ... ok", r.path);
+                    println!("test {} ... ok", shown(&r.path));
                 }
                 Some(report) => {
                     failed += 1;
-                    println!("test {} ... FAILED", r.path);
+                    println!("test {} ... FAILED", shown(&r.path));
                     reports.push(report);
                 }
             }
@@ -165,19 +217,24 @@ pub(crate) fn test(args: TestArgs) -> ExitCode {
             all += a;
         }
     }
-    if let Some(mut t) = trace {
-        if t.flush().is_err() || t.errors() > 0 {
+    if let (Some(t), Some(path)) = (trace, &args.trace) {
+        if t.errors() > 0 {
             return fail("the trace could not be written whole (a write failed)");
+        }
+        drop(t);
+        let text = trace_bytes.take();
+        if let Err(e) = rcs_codegen::writer::write_file(path, &text, &inputs, &mut |_| {}) {
+            return write_failed(&e);
         }
     }
     if !reports.is_empty() {
         println!("\nfailures:\n");
         for r in &reports {
-            println!("{r}");
+            println!("{}", shown(&r.to_string()));
         }
     }
     if args.coverage {
-        print!("{coverage_text}");
+        print!("{}", shown(&coverage_text));
         println!("rows fired: {hit}/{all}\n");
     }
     status.line(

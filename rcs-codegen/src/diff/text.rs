@@ -1,6 +1,9 @@
 //! The diff as text for a terminal: one line per change, `+` added, `-`
 //! removed, `~` changed, `=` renumbered, `⇅` moved in precedence;
-//! coloured with ANSI escapes when asked.
+//! coloured with ANSI escapes when asked. Text from the plans (names,
+//! rows, messages) enters only through [`Paint`] or [`shown`], which escape
+//! its control characters, so the only escapes that reach a terminal are
+//! the colours.
 
 use super::*;
 use rcs_dsl::diff::{Finding, PlanSetDiff};
@@ -8,8 +11,14 @@ use std::fmt::Write;
 
 struct Paint(bool);
 
+/// Text from the plans with its control characters escaped.
+fn shown(text: &str) -> std::borrow::Cow<'_, str> {
+    rcs_dsl::render::escape_controls(text)
+}
+
 impl Paint {
     fn mark(&self, mark: char, text: &str) -> String {
+        let text = shown(text);
         let code = match mark {
             '+' => "32",
             '-' => "31",
@@ -25,10 +34,11 @@ impl Paint {
     }
 
     fn bold(&self, text: &str) -> String {
+        let text = shown(text);
         if self.0 {
             format!("\x1b[1m{text}\x1b[0m")
         } else {
-            text.to_string()
+            text.into_owned()
         }
     }
 }
@@ -125,11 +135,11 @@ fn row(out: &mut String, paint: &Paint, r: &RowDiff) {
         (RowChange::Changed(_), _, _) => {
             let _ = writeln!(out, "      {}", paint.mark('~', &row_name(r)));
             for (part, a, b) in changed_parts(r) {
-                let _ = writeln!(out, "          {part}: {a} → {b}");
+                let _ = writeln!(out, "          {part}: {} → {}", shown(&a), shown(&b));
             }
         }
         (RowChange::Same, _, _) if r.renumbered() => {
-            let _ = writeln!(out, "      = {}", row_name(r));
+            let _ = writeln!(out, "      = {}", shown(&row_name(r)));
         }
         _ => {}
     }
@@ -147,7 +157,7 @@ fn block_row(out: &mut String, paint: &Paint, r: &RowDiff) {
         (RowChange::Changed(_), Some(o), _) => {
             let _ = writeln!(out, "      {}", paint.mark('~', &o.content()));
             for (part, a, b) in changed_parts(r) {
-                let _ = writeln!(out, "          {part}: {a} → {b}");
+                let _ = writeln!(out, "          {part}: {} → {}", shown(&a), shown(&b));
             }
         }
         _ => {}

@@ -401,3 +401,71 @@ fn a_folder_another_build_is_writing_is_left_to_it() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn one_named_file_follows_the_rules_of_a_build() {
+    let dir = scratch("single");
+    let inputs_dir = dir.join("plans");
+    std::fs::create_dir_all(&inputs_dir).unwrap();
+    let plan = inputs_dir.join("a.rcs");
+    std::fs::write(&plan, format!("// {GENERATED}, says the plan\n")).unwrap();
+    let mut inputs = Inputs::new();
+    inputs.add(&plan);
+    let body = format!("// {GENERATED}\nnew\n");
+
+    // A file read is refused, under any name, marker or not.
+    let err = write_file(&plan, &body, &inputs, &mut quiet).unwrap_err();
+    assert!(matches!(err, WriteError::Input { .. }), "{err}");
+    let other_name = inputs_dir.join("../plans/a.rcs");
+    assert!(write_file(&other_name, &body, &inputs, &mut quiet).is_err());
+    #[cfg(unix)]
+    {
+        let hard = dir.join("hard.rcs");
+        std::fs::hard_link(&plan, &hard).unwrap();
+        assert!(write_file(&hard, &body, &inputs, &mut quiet).is_err());
+    }
+    assert!(std::fs::read_to_string(&plan)
+        .unwrap()
+        .ends_with("says the plan\n"));
+
+    // A hand-written file is refused; a folder is in the way.
+    let out = dir.join("out.txt");
+    std::fs::write(&out, "mine\n").unwrap();
+    let err = write_file(&out, &body, &inputs, &mut quiet).unwrap_err();
+    assert!(matches!(err, WriteError::NotGenerated(_)), "{err}");
+    assert_eq!(err.code(), Some("not_generated"));
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "mine\n");
+    let err = write_file(&inputs_dir, &body, &Inputs::new(), &mut quiet).unwrap_err();
+    assert!(matches!(err, WriteError::InTheWay { .. }), "{err}");
+
+    // Its own output is replaced, unchanged bytes are left alone, and no
+    // lock or temporary is left behind.
+    std::fs::remove_file(&out).unwrap();
+    let report = write_file(&out, &body, &inputs, &mut quiet).unwrap();
+    assert_eq!(report.written, vec![out.clone()]);
+    let report = write_file(&out, &body, &inputs, &mut quiet).unwrap();
+    assert_eq!(report.unchanged, vec![out.clone()]);
+    let newer = format!("// {GENERATED}\nnewer\n");
+    write_file(&out, &newer, &inputs, &mut quiet).unwrap();
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), newer);
+    let left: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(RESERVED_PREFIX))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+
+    // A link to a generated file is followed: the file it names is replaced.
+    #[cfg(unix)]
+    {
+        let link = dir.join("link.txt");
+        std::os::unix::fs::symlink("out.txt", &link).unwrap();
+        write_file(&link, &body, &inputs, &mut quiet).unwrap();
+        assert!(std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), body);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -4,6 +4,12 @@
 //! - `human`: rustc-like snippets (codespan-reporting), colour optional;
 //! - `short`: one `file:line:col: severity[code]: message` line;
 //! - `json`: one object per line (see [`json`]).
+//!
+//! Text from the plans (names, messages, file paths, the source lines of a
+//! snippet) may hold control characters. The human and short formats show
+//! each as an escape ([`escape_controls`]), so that a plan cannot drive the
+//! terminal it is checked on; JSON escapes C0 controls by its grammar, and
+//! DEL and C1 here as well (`\u007f`, `\u009b`).
 
 use crate::diagnostic::{Diagnostic, Severity};
 use crate::source::{FileId, SourceMap, Span};
@@ -13,7 +19,44 @@ use codespan_reporting::diagnostic as cs;
 use codespan_reporting::files::{Error as FilesError, Files};
 use codespan_reporting::term;
 use serde::Serialize;
+use std::borrow::Cow;
 use std::ops::Range;
+
+/// `text` with every control character but newline and tab (ESC, the rest
+/// of C0, DEL, C1) written as a Rust escape, `\u{1b}`; borrowed when there
+/// is none.
+pub fn escape_controls(text: &str) -> Cow<'_, str> {
+    let shown = |c: char| !c.is_control() || c == '\n' || c == '\t';
+    if text.chars().all(shown) {
+        return Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        if shown(c) {
+            out.push(c);
+        } else {
+            out.extend(c.escape_unicode());
+        }
+    }
+    Cow::Owned(out)
+}
+
+/// JSON text with DEL and the C1 controls, which JSON leaves as they are,
+/// escaped as `\u00XX` (they can only stand inside strings).
+fn escape_json_controls(json: String) -> String {
+    if !json.chars().any(|c| ('\u{7f}'..='\u{9f}').contains(&c)) {
+        return json;
+    }
+    let mut out = String::with_capacity(json.len() + 12);
+    for c in json.chars() {
+        if ('\u{7f}'..='\u{9f}').contains(&c) {
+            out.push_str(&format!("\\u{:04x}", c as u32));
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
@@ -28,7 +71,8 @@ pub fn render(d: &Diagnostic, sources: &SourceMap, format: Format) -> String {
         Format::Human { color } => human(d, sources, color),
         Format::Short => short(d, sources),
         Format::Json => {
-            let mut s = serde_json::to_string(&json(d, sources)).expect("diagnostics serialise");
+            let s = serde_json::to_string(&json(d, sources)).expect("diagnostics serialise");
+            let mut s = escape_json_controls(s);
             s.push('\n');
             s
         }
@@ -97,35 +141,39 @@ fn to_codespan(d: &Diagnostic) -> cs::Diagnostic<FileId> {
             } else {
                 cs::LabelStyle::Secondary
             };
-            cs::Label::new(style, l.span.file, l.span.range()).with_message(&l.message)
+            cs::Label::new(style, l.span.file, l.span.range())
+                .with_message(escape_controls(&l.message))
         })
         .collect();
-    let mut notes: Vec<String> = d.notes.iter().map(|n| format!("note: {n}")).collect();
+    let mut notes: Vec<String> = d
+        .notes
+        .iter()
+        .map(|n| format!("note: {}", escape_controls(n)))
+        .collect();
     if let Some(h) = &d.help {
-        notes.push(format!("help: {h}"));
+        notes.push(format!("help: {}", escape_controls(h)));
     }
     cs::Diagnostic::new(severity)
         .with_code(d.code.name())
-        .with_message(&d.message)
+        .with_message(escape_controls(&d.message))
         .with_labels(labels)
         .with_notes(notes)
 }
 
 fn human(d: &Diagnostic, sources: &SourceMap, color: bool) -> String {
-    let shown = if long_lines::needed(d, sources) {
-        // Long lines cut around the labels, the labels moved to match.
-        let cut = long_lines::CutFiles::new(d, sources);
-        let mut moved = d.clone();
-        for l in &mut moved.labels {
-            let f = l.span.file;
-            let (start, end) = (l.span.start as usize, l.span.end as usize);
-            l.span = Span::new(f, cut.shown_offset(f, start), cut.shown_offset(f, end));
-        }
-        emit(&moved, &cut, color)
-    } else {
-        emit(d, sources, color)
-    };
-    shown.unwrap_or_else(|| short(d, sources))
+    if long_lines::plain(d, sources) {
+        return emit(d, sources, color).unwrap_or_else(|| short(d, sources));
+    }
+    // The lines the labels stand on, long ones cut and controls escaped;
+    // the labels moved to match.
+    let cut = long_lines::CutFiles::new(d, sources);
+    let mut moved = d.clone();
+    for l in &mut moved.labels {
+        let f = l.span.file;
+        let (start, end) = (l.span.start as usize, l.span.end as usize);
+        l.span = Span::new(f, cut.shown_offset(f, start), cut.shown_offset(f, end));
+    }
+    emit(&moved, &cut, color).unwrap_or_else(|| short(d, sources))
 }
 
 /// `d` as a rustc-like snippet over `files`, `None` if codespan fails.
@@ -158,10 +206,10 @@ fn short(d: &Diagnostic, sources: &SourceMap) -> String {
     let (line, col) = f.line_col(span.start as usize);
     format!(
         "{}:{line}:{col}: {}[{}]: {}\n",
-        f.path,
+        escape_controls(&f.path),
         d.severity.as_str(),
         d.code.name(),
-        d.message
+        escape_controls(&d.message)
     )
 }
 

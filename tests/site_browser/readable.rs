@@ -244,7 +244,23 @@ async fn pages_at_1400_px_are_readable() {
                 .map(|e| format!("{page}: {e}")),
         );
     }
-    // The finding is marked on the graph, and the coverage page has hits.
+    // The wide hierarchy's full-size view: natural size is wider than the
+    // window; Fit shrinks it into the view.
+    c.goto(&file_url(&dir.join("wide/index.html")))
+        .await
+        .unwrap();
+    super::click(&c, "button.graph-open").await;
+    assert_eq!(full_scale(&c).await.map(|s| close_to(s, 1.0)), Some(true));
+    let fit = press(&c, "button.zoom-fit").await;
+    assert!(fit < 0.5, "Fit left the wide hierarchy at {fit}");
+    screenshot(&c, &shots, "index-wide-full-size-fit").await;
+    println!(
+        "screenshot: {}",
+        shots.join("index-wide-full-size-fit.png").display()
+    );
+    errors.extend(console_errors(&c).await);
+
+    // The finding is marked on the graph.
     c.goto(&file_url(&dir.join("finding/VALVE.OPEN.html")))
         .await
         .unwrap();

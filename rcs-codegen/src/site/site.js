@@ -6,9 +6,10 @@
 //   load.
 // - The full-size view of a graph: the "Full size" button on each graph,
 //   or a click on the graph's background (not on one of its links, which
-//   keep leading to their row or state), opens a modal dialog showing the
-//   same SVG at its natural size, to pan (drag; arrow keys) and zoom (wheel
-//   or pinch about the pointer; + / − / 1:1 / Fit buttons; keys + - 0).
+//   keep leading to their row or state; not its box's scroll bar), opens a
+//   modal dialog showing the same SVG at its natural size, to pan (drag;
+//   arrow keys) and zoom (wheel or pinch about the pointer; + / − / 1:1 /
+//   Fit buttons; keys + - 0).
 //   Esc, the Close button or a click outside the graph's dialog closes it;
 //   a link followed from it closes it first.
 (function () {
@@ -304,7 +305,9 @@
     box.parentNode.insertBefore(b, box);
     b.addEventListener("click", function () { open(box, b); });
     box.addEventListener("click", function (ev) {
-      if (linkOf(ev.target, box)) { return; }
+      // In the drawing only: not on the box's scroll bar or beside the SVG.
+      var inSvg = ev.target.closest ? ev.target.closest("svg") : null;
+      if (!inSvg || linkOf(ev.target, box)) { return; }
       var sel = window.getSelection && window.getSelection();
       if (sel && !sel.isCollapsed) { return; }
       open(box, b);

@@ -25,7 +25,10 @@ subordinates) and a page per plan (its state graph, states, state table
 with the rows' doc comments and the findings of `rcsc check` on the rows
 they concern, and its source). Every edge and node of a graph links to its
 table row, every row to its edge and source line, and back. A search box
-finds controllers, verbs, buffers and states.
+finds controllers, verbs, buffers and states. A graph is shrunk to the
+page's width but never so far that its text is under 10 px (its box
+scrolls instead); its “Full size” button, or a click on its background,
+shows it at natural size to pan (drag) and zoom (wheel, pinch, buttons).
 
 The graphs are drawn by Graphviz `dot` (package `graphviz`). Without it the
 site is written with a notice in place of each drawing, and a warning.

@@ -9,6 +9,10 @@
 //! controller; the search index loaded only when used) and the Changes
 //! page of `rcsc doc --diff` (a changed plan's badge → its changes → back).
 //!
+//! And in `readable`: each kind of page at a 1,400-px window, no page
+//! wider than the window and no graph text under 10 px as rendered, and
+//! the full-size view of a graph (open, zoom, pan, close, follow a link).
+//!
 //! Chromium and chromedriver come from Debian's `chromium` and
 //! `chromium-driver` packages (`.ci/run` installs them). Without them the
 //! test fails and says how to install them, unless `RCSC_SKIP_BROWSER=1`.
@@ -16,6 +20,8 @@
 mod common;
 #[path = "../rcs-dsl/benches/common/plan_set.rs"]
 mod plan_set;
+#[path = "site_browser/readable.rs"]
+mod readable;
 
 use common::site_links::broken_links;
 use common::{rcsc, scratch, text, tree};
@@ -149,12 +155,17 @@ fn browser() -> Option<(PathBuf, PathBuf)> {
 /// A WebDriver session with headless Chromium (and its driver, which must
 /// outlive it).
 async fn session(chromium: &Path, chromedriver: &Path) -> (Driver, Client) {
+    session_sized(chromium, chromedriver, "1280,1000").await
+}
+
+/// A session whose window is `size` ("width,height" in CSS px).
+async fn session_sized(chromium: &Path, chromedriver: &Path, size: &str) -> (Driver, Client) {
     let (driver, port) = start_driver(chromedriver);
     let caps = serde_json::json!({
         "browserName": "chrome",
         "goog:chromeOptions": {
             "binary": chromium,
-            "args": ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1280,1000"]
+            "args": ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", format!("--window-size={size}")]
         },
         "goog:loggingPrefs": { "browser": "ALL" }
     });

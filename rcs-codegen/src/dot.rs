@@ -562,7 +562,7 @@ pub fn hierarchy_graph(ir: &Ir) -> String {
                 "    subgraph {} {{",
                 quoted(&format!("cluster_process_{p}"))
             );
-            out.push_str("        style=solid;\n");
+            out.push_str("        style=solid;\n        label=\"\";\n");
             let _ = writeln!(
                 out,
                 "        {} [shape=plaintext, label={}];",
@@ -615,7 +615,11 @@ fn cpu_cluster(out: &mut String, ir: &Ir, indent: &str, i: usize, cpu: &Cpu) {
     // The cluster's name is a node above its controllers (an invisible
     // edge to each keeps it there), not the cluster's label: Graphviz
     // routes edges around nodes, but through a cluster's label.
-    let _ = writeln!(out, "{indent}        style=dashed;");
+    // `label=""`: a cluster inherits the graph's label (the title) otherwise.
+    let _ = writeln!(
+        out,
+        "{indent}        style=dashed;\n{indent}        label=\"\";"
+    );
     let label = quoted(&format!("cpu_label_{i}"));
     let _ = writeln!(
         out,

@@ -15,10 +15,19 @@ pub(super) fn buffer_anchor(ir: &Ir, name: &str) -> String {
     format!("b-{}.{name}", ir.system)
 }
 
-/// A graph's SVG, or the notice that stands for it.
+/// A graph's SVG, or the notice that stands for it. The SVG is shrunk to
+/// the page's width but not below the width that keeps its smallest text
+/// at 10 px (`--min-width`, see `site.css`; the box scrolls past it), and
+/// `site.js` gives it a full-size view.
 pub(super) fn graph_or_notice(svg: Option<&String>, what: &str) -> String {
     match svg {
-        Some(s) => format!("<div class=\"graph\">\n{}\n</div>\n", svg::inline(s)),
+        Some(s) => {
+            let s = svg::inline(s);
+            let style = svg::min_width_px(s)
+                .map(|px| format!(" style=\"--min-width: {px}px\""))
+                .unwrap_or_default();
+            format!("<div class=\"graph\"{style}>\n{s}\n</div>\n")
+        }
         None => format!(
             "<p class=\"notice\">No drawing of {}: Graphviz <code>dot</code> was not found when the site was built. Install Graphviz (e.g. <code>apt-get install graphviz</code>) and run <code>rcsc doc</code> again.</p>\n",
             esc(what)

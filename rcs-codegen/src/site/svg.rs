@@ -102,6 +102,54 @@ pub(super) fn inline(svg: &str) -> &str {
     }
 }
 
+/// The smallest text a graph may show on a page, in CSS px (issue 29).
+pub(super) const MIN_TEXT_PX: f64 = 10.0;
+
+/// How wide, in CSS px, `svg` (Graphviz's, inlined) must be shown so that
+/// its smallest text is still [`MIN_TEXT_PX`]: the page shrinks a graph to
+/// its column (`max-width: 100%` in `site.css`), and this is the floor it
+/// may not go under (`min-width`; past it the graph's box scrolls). Text of
+/// `font-size` f user units in a viewBox w units wide, shown W px wide, is
+/// f·W/w px high, so W ≥ 10·w/f. `None` without a viewBox or text (the
+/// stand-in SVGs of tests).
+pub(super) fn min_width_px(svg: &str) -> Option<u32> {
+    let tag = &svg[..svg.find('>')?];
+    let view_width: f64 = attr(tag, "viewBox")?
+        .split_whitespace()
+        .nth(2)?
+        .parse()
+        .ok()?;
+    // Graphviz scales its whole drawing in the first group's transform
+    // (`scale(1 1)` unless the DOT asks for a size).
+    let scale = svg
+        .find("transform=\"scale(")
+        .and_then(|at| svg[at + 17..].split([' ', ')']).next()?.parse::<f64>().ok())
+        .filter(|s| *s > 0.0)
+        .unwrap_or(1.0);
+    let smallest = svg
+        .match_indices("font-size=\"")
+        .filter_map(|(at, m)| {
+            let rest = &svg[at + m.len()..];
+            rest[..rest.find('"')?].parse::<f64>().ok()
+        })
+        .filter(|f| *f > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    if !smallest.is_finite() || view_width <= 0.0 {
+        return None;
+    }
+    Some((MIN_TEXT_PX * view_width / (smallest * scale)).ceil() as u32)
+}
+
+/// The value of attribute `name` in a start tag's text.
+fn attr<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
+    let needle = format!(" {name}=\"");
+    let at = tag
+        .find(&needle)
+        .or_else(|| tag.find(&format!("\n{name}=\"")))?;
+    let rest = &tag[at + needle.len()..];
+    Some(&rest[..rest.find('"')?])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -143,5 +191,16 @@ mod tests {
             inline("<?xml?>\n<!DOCTYPE svg>\n<svg a>\n</svg>\n"),
             "<svg a>\n</svg>"
         );
+    }
+
+    #[test]
+    fn the_floor_keeps_the_smallest_text_at_10_px() {
+        let svg = "<svg width=\"723pt\" height=\"527pt\"\n viewBox=\"0.00 0.00 723.20 526.75\" xmlns=\"x\">\n<g transform=\"scale(1 1) rotate(0)\"><text font-size=\"14.00\">a</text><text font-size=\"11.00\">b</text></g></svg>";
+        // 11 units in 723.2 → 10 px at 657.5 px wide.
+        assert_eq!(min_width_px(svg), Some(658));
+        let halved = svg.replace("scale(1 1)", "scale(0.5 0.5)");
+        assert_eq!(min_width_px(&halved), Some(1315));
+        assert_eq!(min_width_px("<svg xmlns=\"x\"><text>a</text></svg>"), None);
+        assert_eq!(min_width_px("<svg viewBox=\"0 0 10 10\"></svg>"), None);
     }
 }

@@ -66,12 +66,12 @@
 //! writer's side too (they force the value through the stack), volatile
 //! stores into the reader's copy (it then costs one more copy out), and a
 //! `memcpy` on both sides for large values (its access widths differ
-//! between the two sides, so the reader's loads are not forwarded). For
-//! values over 256 bytes the reader holds more chunks than there are
-//! registers until the counter check and spills the rest to the stack; a
-//! copy can only go straight to its destination before the check if the
-//! destination is the caller's memory, which `read`'s by-value result is
-//! not.
+//! between the two sides, so the reader's loads are not forwarded), 32-byte
+//! AVX chunks chosen at run time for values over 256 bytes, and a reader
+//! copying into memory it keeps out of registers. At 512 bytes none of
+//! these beat the 16-byte chunks (≈ 35 ns for a write and a read, against
+//! 19–39 ns for a plain copy of the value in and out, depending on how the
+//! run's stack happens to be aligned).
 
 use std::cell::UnsafeCell;
 use std::fmt;

@@ -484,8 +484,11 @@ impl Executive {
                     });
             }
             if let (Some(clock), Some(start)) = (&self.clock, &start) {
-                let t1_ns = clock.elapsed_ns(start);
-                let ns = t1_ns.saturating_sub(t0_ns);
+                // `max`: a counter read behind the last one (the thread
+                // moved to a core whose TSC lags) counts as 0 ns and keeps
+                // each controller's `now` at or after the one before.
+                let t1_ns = clock.elapsed_ns(start).max(t0_ns);
+                let ns = t1_ns - t0_ns;
                 slot.stats.exec_ns.record(ns);
                 if ns > self.period_ns {
                     slot.stats.overruns = slot.stats.overruns.saturating_add(1);

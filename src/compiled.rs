@@ -252,7 +252,7 @@ pub fn build(
         if stderr.contains("offline") || stderr.contains("registry") {
             message.push_str(
                 "\nhelp: the driver needs rcs-runtime's dependencies (serde, serde_json, \
-                 thiserror) in cargo's registry cache, as after building or installing \
+                 thiserror, quanta) in cargo's registry cache, as after building or installing \
                  rcsc, or access to crates.io",
             );
         }
@@ -356,6 +356,7 @@ mod tests {
             "serde = { version = \"1\", features = [\"derive\"] }",
             "serde_json = \"1\"",
             "thiserror = \"2\"",
+            "quanta = { version = \"0.12\", default-features = false }",
         ] {
             assert!(manifest.lines().any(|l| l == line), "{line}:\n{manifest}");
         }

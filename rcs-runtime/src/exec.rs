@@ -37,6 +37,7 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+use crate::clock::CycleClock;
 use crate::error::SetupError;
 use crate::fault::{panic_message, ControllerPanic, CycleFault};
 use crate::handshake::ErrorCode;
@@ -50,7 +51,9 @@ use crate::trace::{TraceRecord, TraceSink};
 pub struct CycleContext {
     /// The executive's cycle count (0 on the first cycle). Stamp writes with it.
     pub cycle: u64,
-    /// When this controller's turn began.
+    /// When this controller's turn began (with measuring off, when the
+    /// cycle began). The executive reads `Instant::now()` once per cycle
+    /// and adds the TSC time elapsed since for each later controller.
     pub now: Instant,
     /// The executive's period.
     pub period: Duration,
@@ -144,9 +147,12 @@ pub struct ExecutiveConfig {
     pub period: Duration,
     /// How to wait for deadlines (default: sleep, then spin the last 200 µs).
     pub wait: Wait,
-    /// Measure per-controller execution time (default true). Turning it off
-    /// saves two clock reads per controller per cycle; overruns are then
-    /// judged on the whole cycle only.
+    /// Measure per-controller execution time (default true): one read of
+    /// the CPU's time-stamp counter per controller per cycle (the OS clock
+    /// where there is no invariant TSC; see the `clock` module). Turning it
+    /// off saves those reads; overruns are then judged on the whole cycle
+    /// only, and every controller's [`CycleContext::now`] is the start of
+    /// the cycle.
     pub measure: bool,
 }
 
@@ -251,7 +257,8 @@ pub struct Executive {
     name: String,
     period: Duration,
     period_ns: u64,
-    measure: bool,
+    /// The per-controller timing clock; `None` with measuring off.
+    clock: Option<CycleClock>,
     heartbeat: Heartbeat,
     slots: Vec<Slot>,
     cycle: u64,
@@ -291,7 +298,8 @@ impl Executive {
             heartbeat: Heartbeat::new(config.period, config.wait)?,
             period_ns: nanos(config.period),
             period: config.period,
-            measure: config.measure,
+            // Calibrated here (once per process), not on the first cycle.
+            clock: config.measure.then(CycleClock::new),
             name: config.name,
             slots: Vec::new(),
             cycle: 0,
@@ -441,8 +449,12 @@ impl Executive {
     fn run_one(&mut self) {
         let cycle = self.cycle;
         let period = self.period;
-        let start = Instant::now();
-        let mut t0 = start;
+        // One `Instant` per cycle; with measuring on, each controller's
+        // `now` and execution time come from the TSC (see `crate::clock`).
+        let start = self.clock.as_ref().map(CycleClock::start);
+        let start_instant = start.map_or_else(Instant::now, |s| s.instant);
+        let mut t0 = start_instant;
+        let mut t0_ns = 0u64;
         for slot in &mut self.slots {
             let ctx = CycleContext {
                 cycle,
@@ -471,14 +483,18 @@ impl Executive {
                         message,
                     });
             }
-            if self.measure {
-                let t1 = Instant::now();
-                let ns = nanos(t1.saturating_duration_since(t0));
+            if let (Some(clock), Some(start)) = (&self.clock, &start) {
+                // `max`: a counter read behind the last one (the thread
+                // moved to a core whose TSC lags) counts as 0 ns and keeps
+                // each controller's `now` at or after the one before.
+                let t1_ns = clock.elapsed_ns(start).max(t0_ns);
+                let ns = t1_ns - t0_ns;
                 slot.stats.exec_ns.record(ns);
                 if ns > self.period_ns {
                     slot.stats.overruns = slot.stats.overruns.saturating_add(1);
                 }
-                t0 = t1;
+                t0_ns = t1_ns;
+                t0 = start.after(t1_ns);
             }
             if let Some(trace) = &mut self.trace {
                 let bk = slot.ctrl.bookkeeping();
@@ -495,8 +511,11 @@ impl Executive {
                 });
             }
         }
-        let end = if self.measure { t0 } else { Instant::now() };
-        let ns = nanos(end.saturating_duration_since(start));
+        let ns = if start.is_some() {
+            t0_ns
+        } else {
+            nanos(start_instant.elapsed())
+        };
         self.stats.cycle_ns.record(ns);
         if ns > self.period_ns {
             self.stats.overruns = self.stats.overruns.saturating_add(1);

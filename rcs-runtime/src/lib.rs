@@ -14,6 +14,7 @@
 //! | [`handshake`] | [`CommandBuffer`], [`StatusBuffer`], serials, [`SubordinateLink`] / [`Subordinate`] (a supervisor's view of a subordinate) |
 //! | [`plan`] | [`Bookkeeping`]: new-command detection, state, status, counters, fired row, per-verb durations |
 //! | [`exec`] | [`Controller`], [`Executive`] (the main program), [`Heartbeat`], pause/step/go through [`ExecutiveHandle`] |
+//! | `clock` | the executive's per-controller timing from the TSC (`quanta`), falling back to the OS clock |
 //! | [`math`] | the float built-in functions of the language (`sqrt`, `min`, …), shared by generated code and the interpreter |
 //! | [`operator`] | [`Operator`]: command a root controller, read status |
 //! | [`trace`] | optional JSON-lines trace of every controller's cycle |
@@ -187,6 +188,7 @@
 pub mod acl;
 #[cfg(feature = "zenoh")]
 pub mod bridge;
+mod clock;
 pub mod driver;
 pub mod epoch;
 pub mod error;

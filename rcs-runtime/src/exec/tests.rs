@@ -221,3 +221,66 @@ fn every_cycle_raises_the_attached_signal() -> Result<(), Box<dyn std::error::Er
     assert!(!signal.take(), "detached");
     Ok(())
 }
+
+/// Keeps the `now` of each of its cycles, then sleeps `ms`.
+struct Sleeper {
+    name: &'static str,
+    ms: u64,
+    seen: Vec<Instant>,
+}
+
+impl Controller for Sleeper {
+    fn name(&self) -> &str {
+        self.name
+    }
+    fn cycle(&mut self, ctx: &CycleContext) {
+        self.seen.push(ctx.now);
+        std::thread::sleep(Duration::from_millis(self.ms));
+    }
+}
+
+/// With measuring on, a controller's `now` is when its own turn began: the
+/// cycle's `Instant` plus the TSC time the controllers before it took
+/// (here at least A's 5 ms sleep, less 10 % for the calibration), and that
+/// time is in A's statistics. With measuring off every controller gets the
+/// start of the cycle. Lower bounds only: a loaded machine only lengthens.
+#[test]
+fn each_controller_sees_when_its_turn_began() -> Result<(), Box<dyn std::error::Error>> {
+    for measure in [true, false] {
+        let cfg = ExecutiveConfig::new("cpu", Duration::from_secs(10)).with_measure(measure);
+        let mut e = Executive::new(cfg)?;
+        for (name, ms) in [("A", 5), ("B", 0)] {
+            e.add(Box::new(Sleeper {
+                name,
+                ms,
+                seen: Vec::new(),
+            }))?;
+        }
+        let before = Instant::now();
+        e.run_cycles(3)?;
+        let seen = |name| e.controller_as::<Sleeper>(name).map(|s| s.seen.clone());
+        let (a, b) = (seen("A").unwrap(), seen("B").unwrap());
+        assert_eq!((a.len(), b.len()), (3, 3));
+        for (ta, tb) in a.iter().zip(&b) {
+            assert!(*ta >= before);
+            let gap = tb.duration_since(*ta);
+            if measure {
+                assert!(
+                    gap >= Duration::from_micros(4500),
+                    "B began {gap:?} after A"
+                );
+            } else {
+                assert_eq!(gap, Duration::ZERO);
+            }
+        }
+        let stats = e.controller_stats("A").unwrap().exec_ns;
+        if measure {
+            assert_eq!(stats.count, 3);
+            assert!(stats.min >= 4_500_000, "A took {} ns", stats.min);
+            assert!(e.stats().cycle_ns.min >= stats.min);
+        } else {
+            assert_eq!(stats.count, 0);
+        }
+    }
+    Ok(())
+}

@@ -106,6 +106,19 @@ def rcsc_crate(out, n, rcsc):
     write(os.path.join(out, "src/events.rs"), events_rs(n))
 
 
+def library_crate(out, n, library, version, mods):
+    """A crate of machine modules `m<i>` (each with `run(events) -> u64`)
+    over one state-machine library, its main summing their checksums."""
+    write(os.path.join(out, "Cargo.toml"),
+          "[package]\nname = \"machines-%s\"\nversion = \"0.1.0\"\nedition = \"2021\"\n\n"
+          "[dependencies]\n%s = \"%s\"\n\n[workspace]\n" % (library, library, version))
+    runs = "\n".join("    sum += m%d::run(EVENTS[%d]);" % (i, i) for i in range(n))
+    write(os.path.join(out, "src/main.rs"),
+          "mod events;\nuse events::EVENTS;\n%s\nfn main() {\n    let mut sum = 0u64;\n%s\n    println!(\"checksum {sum}\");\n}\n"
+          % ("\n".join(mods), runs))
+    write(os.path.join(out, "src/events.rs"), events_rs(n))
+
+
 def smlang_crate(out, n):
     mods = []
     for i in range(n):
@@ -123,14 +136,7 @@ def smlang_crate(out, n):
             "            let _ = sm.process_event(ev);\n        }\n"
             "        let s = match sm.state() { States::S1 => 1, States::S2 => 2, States::S3 => 3, States::S4 => 4, States::S5 => 5 };\n"
             "        s * 1000 + u64::from(sm.context().count)\n    }\n}\n" % (i, trans, acts))
-    write(os.path.join(out, "Cargo.toml"),
-          "[package]\nname = \"machines-smlang\"\nversion = \"0.1.0\"\nedition = \"2021\"\n\n"
-          "[dependencies]\nsmlang = \"0.8\"\n\n[workspace]\n")
-    runs = "\n".join("    sum += m%d::run(EVENTS[%d]);" % (i, i) for i in range(n))
-    write(os.path.join(out, "src/main.rs"),
-          "mod events;\nuse events::EVENTS;\n%s\nfn main() {\n    let mut sum = 0u64;\n%s\n    println!(\"checksum {sum}\");\n}\n"
-          % ("\n".join(mods), runs))
-    write(os.path.join(out, "src/events.rs"), events_rs(n))
+    library_crate(out, n, "smlang", "0.8", mods)
 
 
 def statig_crate(out, n):
@@ -151,14 +157,7 @@ def statig_crate(out, n):
             "        for e in events { sm.handle(e); }\n"
             "        let s = match sm.state() { State::S1 {} => 1, State::S2 {} => 2, State::S3 {} => 3, State::S4 {} => 4, State::S5 {} => 5 };\n"
             "        s * 1000 + u64::from(sm.count)\n    }\n}\n" % (i, "".join(arms)))
-    write(os.path.join(out, "Cargo.toml"),
-          "[package]\nname = \"machines-statig\"\nversion = \"0.1.0\"\nedition = \"2021\"\n\n"
-          "[dependencies]\nstatig = \"0.4\"\n\n[workspace]\n")
-    runs = "\n".join("    sum += m%d::run(EVENTS[%d]);" % (i, i) for i in range(n))
-    write(os.path.join(out, "src/main.rs"),
-          "mod events;\nuse events::EVENTS;\n%s\nfn main() {\n    let mut sum = 0u64;\n%s\n    println!(\"checksum {sum}\");\n}\n"
-          % ("\n".join(mods), runs))
-    write(os.path.join(out, "src/events.rs"), events_rs(n))
+    library_crate(out, n, "statig", "0.4", mods)
 
 
 def main():

@@ -59,8 +59,8 @@ fn building_plans_builds_each_set_into_its_own_folder_with_its_own_schedule() {
     // Each set keeps its own manifest: submarine's 30 ms CPU, figure13's default 10 ms.
     let sub = std::fs::read_to_string(out.join("submarine/rust/submarine.rs")).unwrap();
     let fig = std::fs::read_to_string(out.join("figure13/rust/figure13.rs")).unwrap();
-    assert!(sub.contains("from_nanos(30000000u64)"), "30 ms period");
-    assert!(fig.contains("from_nanos(10000000u64)"), "10 ms period");
+    assert!(sub.contains(", 30000000u64);"), "30 ms period");
+    assert!(fig.contains(", 10000000u64);"), "10 ms period");
     // The same tree as naming the sets.
     let named = scratch("plans-named", &[]);
     let o = rcsc(&[

@@ -36,4 +36,17 @@ pub enum SetupError {
     /// heartbeat) or above [`MAX_PERIOD`](crate::exec::MAX_PERIOD).
     #[error("a heartbeat period must be more than zero and at most one hour, not {0:?}")]
     HeartbeatPeriod(std::time::Duration),
+    /// A controller was added to an executive that was never made.
+    #[error("controller `{0}` is added to an executive that does not exist")]
+    UnknownExecutive(String),
+    /// Every error of a setup that met more than one
+    /// ([`Setup::finish`](crate::Setup::finish)), in the order met.
+    #[error("{}", several(.0))]
+    Several(Vec<SetupError>),
+}
+
+/// "3 setup errors: A; B; C".
+fn several(errors: &[SetupError]) -> String {
+    let list: Vec<String> = errors.iter().map(ToString::to_string).collect();
+    format!("{} setup errors: {}", errors.len(), list.join("; "))
 }

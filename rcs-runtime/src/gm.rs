@@ -81,17 +81,43 @@ impl GlobalMemory {
     /// Declare buffer `name` holding a `T`. Declaring it again with the same
     /// type is allowed and changes nothing; another type is an error.
     pub fn declare<T: BufferData>(&self, name: &str) -> Result<(), SetupError> {
+        self.declare_erased(name, TypeKey::of::<T>())
+    }
+
+    /// The writer of buffer `name`. Only one is ever handed out per buffer.
+    pub fn writer<T: BufferData>(&self, name: &str) -> Result<Writer<T>, SetupError> {
+        let (cell, name) = self.handle_erased(name, TypeKey::of::<T>(), true)?;
+        Ok(Writer {
+            cell: typed_cell::<T>(cell, &name)?,
+            name,
+        })
+    }
+
+    /// A reader of buffer `name`; any number may exist.
+    pub fn reader<T: BufferData>(&self, name: &str) -> Result<Reader<T>, SetupError> {
+        let (cell, name) = self.handle_erased(name, TypeKey::of::<T>(), false)?;
+        Ok(Reader {
+            cell: typed_cell::<T>(cell, &name)?,
+            name,
+        })
+    }
+
+    // The type-erased cores of the typed calls above: every generic method
+    // of Global Memory is a thin wrapper over one of these, so a plan set
+    // with a hundred command types instantiates a hundred small wrappers,
+    // not a hundred copies of the map lookups and error paths (issue 30).
+
+    fn declare_erased(&self, name: &str, key: TypeKey) -> Result<(), SetupError> {
         let mut map = self.lock();
         match map.get(name) {
-            Some(e) => check_type::<T>(name, e),
+            Some(e) => e.check(name, key),
             None => {
-                let cell: Arc<Cell<T>> = Arc::new(SeqLock::new((T::default(), 0)));
                 map.insert(
                     name.to_owned(),
                     Entry {
-                        type_id: TypeId::of::<T>(),
-                        type_name: type_name::<T>(),
-                        cell,
+                        type_id: key.id,
+                        type_name: key.name,
+                        cell: (key.new_cell)(),
                         writer_taken: false,
                     },
                 );
@@ -100,34 +126,26 @@ impl GlobalMemory {
         }
     }
 
-    /// The writer of buffer `name`. Only one is ever handed out per buffer.
-    pub fn writer<T: BufferData>(&self, name: &str) -> Result<Writer<T>, SetupError> {
+    /// The cell of buffer `name`, checked to hold `key`'s type, and the
+    /// name to keep in the handle; takes the one writer if `writer`.
+    fn handle_erased(
+        &self,
+        name: &str,
+        key: TypeKey,
+        writer: bool,
+    ) -> Result<(AnyCell, Arc<str>), SetupError> {
         let mut map = self.lock();
         let entry = map
             .get_mut(name)
             .ok_or_else(|| SetupError::UnknownBuffer(name.to_owned()))?;
-        let cell = downcast::<T>(name, entry)?;
-        if entry.writer_taken {
-            return Err(SetupError::WriterTaken(name.to_owned()));
+        entry.check(name, key)?;
+        if writer {
+            if entry.writer_taken {
+                return Err(SetupError::WriterTaken(name.to_owned()));
+            }
+            entry.writer_taken = true;
         }
-        entry.writer_taken = true;
-        Ok(Writer {
-            cell,
-            name: name.into(),
-        })
-    }
-
-    /// A reader of buffer `name`; any number may exist.
-    pub fn reader<T: BufferData>(&self, name: &str) -> Result<Reader<T>, SetupError> {
-        let map = self.lock();
-        let entry = map
-            .get(name)
-            .ok_or_else(|| SetupError::UnknownBuffer(name.to_owned()))?;
-        let cell = downcast::<T>(name, entry)?;
-        Ok(Reader {
-            cell,
-            name: name.into(),
-        })
+        Ok((Arc::clone(&entry.cell), name.into()))
     }
 
     /// The names of all declared buffers, sorted.
@@ -145,7 +163,15 @@ impl GlobalMemory {
     /// [`command_buffer_name`]) and status buffer (`StatusBuffer`, named
     /// [`status_buffer_name`]).
     pub fn declare_controller<C: Command>(&self, ctrl: &str) -> Result<(), SetupError> {
-        self.declare::<CommandBuffer<C>>(&command_buffer_name(ctrl))?;
+        self.declare_controller_erased(ctrl, TypeKey::of::<CommandBuffer<C>>())
+    }
+
+    pub(crate) fn declare_controller_erased(
+        &self,
+        ctrl: &str,
+        command: TypeKey,
+    ) -> Result<(), SetupError> {
+        self.declare_erased(&command_buffer_name(ctrl), command)?;
         self.declare::<StatusBuffer>(&status_buffer_name(ctrl))
     }
 
@@ -155,7 +181,12 @@ impl GlobalMemory {
         &self,
         ctrl: &str,
     ) -> Result<Writer<CommandBuffer<C>>, SetupError> {
-        self.writer(&command_buffer_name(ctrl))
+        let (cell, name) =
+            self.command_handle_erased(ctrl, TypeKey::of::<CommandBuffer<C>>(), true)?;
+        Ok(Writer {
+            cell: typed_cell(cell, &name)?,
+            name,
+        })
     }
 
     /// A reader of `ctrl`'s command buffer (the controller itself reads it).
@@ -163,7 +194,52 @@ impl GlobalMemory {
         &self,
         ctrl: &str,
     ) -> Result<Reader<CommandBuffer<C>>, SetupError> {
-        self.reader(&command_buffer_name(ctrl))
+        let (cell, name) =
+            self.command_handle_erased(ctrl, TypeKey::of::<CommandBuffer<C>>(), false)?;
+        Ok(Reader {
+            cell: typed_cell(cell, &name)?,
+            name,
+        })
+    }
+
+    fn command_handle_erased(
+        &self,
+        ctrl: &str,
+        key: TypeKey,
+        writer: bool,
+    ) -> Result<(AnyCell, Arc<str>), SetupError> {
+        self.handle_erased(&command_buffer_name(ctrl), key, writer)
+    }
+
+    /// [`Setup`](crate::Setup)'s way to a handle: the cell of buffer `name`
+    /// as [`GlobalMemory::writer`] or [`GlobalMemory::reader`] would give
+    /// it, or, if that fails, the error recorded in `errors` and a cell of
+    /// the right type that no Global Memory knows (a stand-in that never
+    /// reaches a running system).
+    pub(crate) fn handle_or_stand_in(
+        &self,
+        name: &str,
+        key: TypeKey,
+        writer: bool,
+        errors: &mut Vec<SetupError>,
+    ) -> (AnyCell, Arc<str>) {
+        self.handle_erased(name, key, writer).unwrap_or_else(|e| {
+            errors.push(e);
+            ((key.new_cell)(), name.into())
+        })
+    }
+
+    /// What a supervisor (or the operator) holds of controller `ctrl`: its
+    /// buffers declared if needed, the writer of its command buffer (taken:
+    /// this is its one supervisor) and a reader of its status.
+    pub(crate) fn supervise<C: Command>(
+        &self,
+        ctrl: &str,
+    ) -> Result<(Writer<CommandBuffer<C>>, Reader<StatusBuffer>), SetupError> {
+        // The typed step last: no error path drops a typed handle.
+        self.declare_controller::<C>(ctrl)?;
+        let status = self.status_reader(ctrl)?;
+        Ok((self.command_writer::<C>(ctrl)?, status))
     }
 
     /// The writer of `ctrl`'s status buffer (held by the controller itself).
@@ -196,27 +272,68 @@ pub fn status_fields_buffer_name(ctrl: &str) -> String {
     format!("{ctrl}.status_fields")
 }
 
-fn check_type<T: 'static>(name: &str, e: &Entry) -> Result<(), SetupError> {
-    if e.type_id == TypeId::of::<T>() {
-        Ok(())
-    } else {
-        Err(SetupError::TypeMismatch {
-            name: name.to_owned(),
-            declared: e.type_name,
-            requested: type_name::<T>(),
-        })
+/// A buffer's cell with its type erased, as Global Memory keeps it.
+pub(crate) type AnyCell = Arc<dyn Any + Send + Sync>;
+
+/// What the type-erased cores need of a buffer's type: its id and name to
+/// check a handle against the declaration, and how to make its cell.
+#[derive(Clone, Copy)]
+pub(crate) struct TypeKey {
+    id: TypeId,
+    name: &'static str,
+    new_cell: fn() -> AnyCell,
+}
+
+impl TypeKey {
+    #[inline]
+    pub(crate) fn of<T: BufferData>() -> Self {
+        Self {
+            id: TypeId::of::<T>(),
+            name: type_name::<T>(),
+            new_cell: new_cell::<T>,
+        }
     }
 }
 
-fn downcast<T: BufferData>(name: &str, e: &Entry) -> Result<Arc<Cell<T>>, SetupError> {
-    check_type::<T>(name, e)?;
-    Arc::clone(&e.cell)
-        .downcast::<Cell<T>>()
-        .map_err(|_| SetupError::TypeMismatch {
-            name: name.to_owned(),
-            declared: e.type_name,
-            requested: type_name::<T>(),
-        })
+fn new_cell<T: BufferData>() -> AnyCell {
+    Arc::new(Cell::<T>::new((T::default(), 0)))
+}
+
+impl Entry {
+    fn check(&self, name: &str, key: TypeKey) -> Result<(), SetupError> {
+        if self.type_id == key.id {
+            Ok(())
+        } else {
+            Err(mismatch(name, self.type_name, key.name))
+        }
+    }
+}
+
+#[cold]
+fn mismatch(name: &str, declared: &'static str, requested: &'static str) -> SetupError {
+    SetupError::TypeMismatch {
+        name: name.to_owned(),
+        declared,
+        requested,
+    }
+}
+
+/// The typed cell of an entry already checked to hold a `T`: the downcast
+/// cannot fail then, but a failure is still an error, not a panic.
+#[inline]
+fn typed_cell<T: BufferData>(cell: AnyCell, name: &str) -> Result<Arc<Cell<T>>, SetupError> {
+    cell.downcast::<Cell<T>>()
+        .map_err(|_| mismatch(name, "another type", type_name::<T>()))
+}
+
+/// The typed cell of a cell [`GlobalMemory::handle_or_stand_in`] gave: it
+/// holds a `T` (checked, or made for one), so the fresh stand-in here is
+/// only there to need no panic.
+pub(crate) fn cell_or_stand_in<T: BufferData>(cell: AnyCell) -> Arc<Cell<T>> {
+    match cell.downcast::<Cell<T>>() {
+        Ok(cell) => cell,
+        Err(_) => Arc::new(Cell::<T>::new((T::default(), 0))),
+    }
 }
 
 /// The single writer of one buffer. Not `Clone`; `write` takes `&mut self`,
@@ -227,6 +344,14 @@ pub struct Writer<T> {
 }
 
 impl<T: BufferData> Writer<T> {
+    /// The writer of a cell [`GlobalMemory::handle_or_stand_in`] gave.
+    pub(crate) fn from_parts((cell, name): (AnyCell, Arc<str>)) -> Self {
+        Self {
+            cell: cell_or_stand_in(cell),
+            name,
+        }
+    }
+
     /// Publish `value`, stamped with the writer's `cycle` count. Returns the
     /// buffer's new generation. Lock-free, allocation-free, wait-free.
     #[inline]
@@ -271,6 +396,14 @@ impl<T> Clone for Reader<T> {
 }
 
 impl<T: BufferData> Reader<T> {
+    /// A reader of a cell [`GlobalMemory::handle_or_stand_in`] gave.
+    pub(crate) fn from_parts((cell, name): (AnyCell, Arc<str>)) -> Self {
+        Self {
+            cell: cell_or_stand_in(cell),
+            name,
+        }
+    }
+
     /// A whole, consistent copy of the buffer with its stamps. Never blocks
     /// the writer; retries if it overlapped a write.
     #[inline]

@@ -445,14 +445,20 @@ impl<C: Command> Subordinate<C> {
     /// Connect to subordinate `ctrl` in `gm` (its buffers are declared if
     /// needed; taking its command writer makes this the only supervisor).
     pub fn connect(gm: &GlobalMemory, ctrl: &str) -> Result<Self, SetupError> {
-        gm.declare_controller::<C>(ctrl)?;
-        Ok(Self {
+        gm.supervise::<C>(ctrl).map(Self::from_parts)
+    }
+
+    /// A subordinate through these handles ([`crate::setup::Ports`]).
+    pub(crate) fn from_parts(
+        (command, status): (Writer<CommandBuffer<C>>, Reader<StatusBuffer>),
+    ) -> Self {
+        Self {
             link: SubordinateLink::fresh(),
-            status: gm.status_reader(ctrl)?,
-            command: gm.command_writer::<C>(ctrl)?,
+            status,
+            command,
             out: Staged::new(CommandBuffer::default()),
             dirty: false,
-        })
+        }
     }
 
     /// Step 1 and 2: read the status buffer once and compute the view.

@@ -204,6 +204,7 @@ pub mod plan;
 pub mod schema;
 mod seqlock;
 pub mod serde_array;
+pub mod setup;
 pub mod signal;
 pub mod trace;
 pub mod watchdog;
@@ -234,6 +235,7 @@ pub use schema::Schema;
 /// types of multi-process plan sets (their crates need not depend on serde).
 #[doc(hidden)]
 pub use serde;
+pub use setup::{BufferDecl, Ports, Setup};
 pub use signal::CycleSignal;
 pub use trace::{read_trace, TraceError, TraceHeader, TraceRecord, TraceSink, TRACE_VERSION};
 pub use watchdog::BufferWatch;

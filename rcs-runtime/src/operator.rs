@@ -35,13 +35,19 @@ impl<C: Command> Operator<C> {
     /// Connect to root controller `root` (declares its buffers if needed and
     /// takes the writer of its command buffer).
     pub fn connect(gm: &GlobalMemory, root: &str) -> Result<Self, SetupError> {
-        gm.declare_controller::<C>(root)?;
-        Ok(Self {
+        gm.supervise::<C>(root).map(Self::from_parts)
+    }
+
+    /// An operator through these handles ([`crate::setup::Ports`]).
+    pub(crate) fn from_parts(
+        (command, status): (Writer<CommandBuffer<C>>, Reader<StatusBuffer>),
+    ) -> Self {
+        Self {
             link: SubordinateLink::fresh(),
-            command: Arc::new(Mutex::new(gm.command_writer(root)?)),
-            status: gm.status_reader(root)?,
+            command: Arc::new(Mutex::new(command)),
+            status,
             sent: 0,
-        })
+        }
     }
 
     /// Send a new command (next serial, this operator's epoch) at once.

@@ -522,6 +522,11 @@ pub(crate) fn module(
         self_name,
         data_init,
     } = shape(names, c, name, shared, vars_for_instance);
+    let inst_arg = if shared.is_some() {
+        quote!(inst,)
+    } else {
+        quote!()
+    };
     quote! {
         #mod_docs
         pub mod #module {
@@ -597,23 +602,28 @@ pub(crate) fn module(
                 /// status buffers, its buffers, and its subordinates' command
                 /// buffers (taking their one writer).
                 pub fn new(gm: &rt::GlobalMemory, #inst_param hooks: H) -> Result<Self, rt::SetupError> {
-                    gm.declare_controller::<Command>(#gm_name)?;
-                    #(gm.declare::<#read_tys>(#read_names)?;)*
-                    #(gm.declare::<#write_tys>(#write_names)?;)*
+                    // Every step runs (a failed one gives a stand-in handle);
+                    // `finish` returns the errors: one exit, not one per handle.
+                    let mut ports = rt::Ports::new(gm);
+                    ports.declare_controller::<Command>(#gm_name);
+                    #(ports.declare::<#read_tys>(#read_names);)*
+                    #(ports.declare::<#write_tys>(#write_names);)*
                     #every_cycle_declares
-                    Ok(Self {
+                    let controller = Self {
                         hooks,
                         data: #data_init,
                         bk: rt::Bookkeeping::new(#verb_count_lit),
-                        command_in: gm.command_reader(#gm_name)?,
-                        status_out: gm.status_writer(#gm_name)?,
+                        command_in: ports.command_reader(#gm_name),
+                        status_out: ports.status_writer(#gm_name),
                         #inst_init
-                        #(#read_handles: gm.reader(#read_names)?,)*
+                        #(#read_handles: ports.reader(#read_names),)*
                         #(#watch_fields: rt::BufferWatch::new(),)*
-                        #(#write_handles: gm.writer(#write_names)?,)*
-                        #(#sub_handles: rt::Subordinate::connect(gm, #sub_names)?,)*
+                        #(#write_handles: ports.writer(#write_names),)*
+                        #(#sub_handles: ports.subordinate(#sub_names),)*
                         #every_cycle_inits
-                    })
+                    };
+                    ports.finish()?;
+                    Ok(controller)
                 }
 
                 /// The data of the last cycle.
@@ -648,6 +658,15 @@ pub(crate) fn module(
                 #accept_method
 
                 #(#plan_fns)*
+            }
+
+            /// [`Controller::new`], boxed for an executive: `System::new`'s
+            /// step for this controller. Out of line and cold, so that a plan
+            /// set's setup code grows with its controllers, not their square.
+            #[cold]
+            #[inline(never)]
+            pub fn boxed<H: Hooks + 'static>(gm: &rt::GlobalMemory, #inst_param hooks: H) -> Result<Box<dyn rt::Controller>, rt::SetupError> {
+                Ok(Box::new(Controller::new(gm, #inst_arg hooks)?))
             }
 
             impl<H: Hooks + 'static> rt::Controller for Controller<H> {

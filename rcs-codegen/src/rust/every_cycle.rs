@@ -152,10 +152,10 @@ pub(crate) fn parts(
         p.handles
             .extend(quote!(status_fields_out: rt::Writer<StatusFields>,));
         p.declares.extend(
-            quote!(gm.declare::<StatusFields>(&rt::status_fields_buffer_name(#own_name))?;),
+            quote!(ports.declare::<StatusFields>(&rt::status_fields_buffer_name(#own_name));),
         );
         p.inits.extend(
-            quote!(status_fields_out: gm.writer(&rt::status_fields_buffer_name(#own_name))?,),
+            quote!(status_fields_out: ports.writer(&rt::status_fields_buffer_name(#own_name)),),
         );
         p.write.extend(quote! {
             self.status_fields_out.write(
@@ -194,10 +194,11 @@ pub(crate) fn parts(
         p.handles
             .extend(quote!(#(#handles: rt::Reader<super::#modules::StatusFields>,)*));
         p.declares.extend(quote! {
-            #(gm.declare::<super::#modules::StatusFields>(&rt::status_fields_buffer_name(#sub_names))?;)*
+            #(ports.declare::<super::#modules::StatusFields>(&rt::status_fields_buffer_name(#sub_names));)*
         });
-        p.inits
-            .extend(quote!(#(#handles: gm.reader(&rt::status_fields_buffer_name(#sub_names))?,)*));
+        p.inits.extend(
+            quote!(#(#handles: ports.reader(&rt::status_fields_buffer_name(#sub_names)),)*),
+        );
         p.read
             .extend(quote!(#(self.data.sub_fields.#fields = self.#handles.read().value;)*));
     }

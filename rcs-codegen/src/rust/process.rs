@@ -19,9 +19,8 @@ use super::names::Names;
 
 /// The pieces of `System::new` that `System::process` shares.
 pub(crate) struct Shared<'a> {
-    /// `gm.declare::<T>(name)?;` for every `reads`/`writes` buffer.
-    pub declare_all: TokenStream,
-    /// `executives[i]`: build CPU `i`'s executive and push it.
+    /// `executives[i]`: make CPU `i`'s executive and add its controllers
+    /// (`rcs_runtime::Setup` calls on `setup`).
     pub executives: &'a [TokenStream],
     /// The `Outputs { … }` and `Operators { … }` expressions.
     pub outputs: TokenStream,
@@ -80,8 +79,8 @@ pub(crate) fn process_api(
     let modules: Vec<_> = names.ctrls.iter().map(|c| &c.module).collect();
     let (cross_tys, cross_names): (Vec<_>, Vec<_>) = crossings.iter().cloned().unzip();
     let declares = quote! {
-        #(gm.declare_controller::<#modules::Command>(#modules::NAME)?;)*
-        #(gm.declare::<#cross_tys>(#cross_names)?;)*
+        #(setup.declare_controller::<#modules::Command>(#modules::NAME);)*
+        #(setup.declare::<#cross_tys>(#cross_names);)*
     };
     let arms = processes.iter().enumerate().map(|(p, process)| {
         let cpus = executives
@@ -135,7 +134,7 @@ pub(crate) fn process_api(
                 #(#bridged)*
                 #(#roots)*
                 #(#cpus)*
-                bridge.start()?
+                bridge
             }
         }
     });
@@ -150,13 +149,12 @@ pub(crate) fn process_api(
             match placement.input_process(ir, rcs_dsl::ir::BufferId(b as u32)) {
                 Some(p) => {
                     let process = processes[p].as_str();
-                    quote!(#f: if process == #process { Some(gm.writer(#name)?) } else { None })
+                    quote!(#f: if process == #process { Some(setup.writer(#name)) } else { None })
                 }
-                None => quote!(#f: Some(gm.writer(#name)?)),
+                None => quote!(#f: Some(setup.writer(#name))),
             }
         });
     let Shared {
-        declare_all,
         outputs,
         operators,
         bounds,
@@ -206,8 +204,9 @@ pub(crate) fn process_api(
                 if config.policy.is_none() {
                     config.policy = Some(#operator_policy.to_owned());
                 }
-                let gm = rt::GlobalMemory::new();
+                let mut setup = rt::Setup::new(&[]);
                 let operators = #operators_expr;
+                let (gm, _) = setup.finish()?;
                 let mut bridge = rt::Bridge::builder(config, &gm);
                 #(#remote_roots)*
                 Ok((operators, bridge.start()?))
@@ -242,10 +241,9 @@ pub(crate) fn process_api(
                 mut config: rt::BridgeConfig,
                 #hooks_param: Hooks #generics,
             ) -> Result<(Self, rt::Bridge), rt::BridgeError> {
-                let gm = rt::GlobalMemory::new();
-                #declare_all
+                let mut setup = rt::Setup::new(&BUFFERS);
                 #declares
-                let mut executives = Vec::new();
+                let gm = setup.gm().clone();
                 let operators = #operators;
                 let bridge = match process {
                     #(#arms)*
@@ -256,12 +254,16 @@ pub(crate) fn process_api(
                         })
                     }
                 };
+                let inputs = Inputs { #(#inputs),* };
+                let outputs = #outputs;
+                let (gm, mut executives) = setup.finish()?;
+                let bridge = bridge.start()?;
                 for exec in &mut executives {
                     exec.set_cycle_signal(bridge.signal());
                 }
                 let system = Self {
-                    inputs: Inputs { #(#inputs),* },
-                    outputs: #outputs,
+                    inputs,
+                    outputs,
                     operators,
                     gm,
                     executives,

@@ -130,28 +130,33 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
         None => quote!(()),
     };
 
-    let executives: Vec<TokenStream> = ir.schedule.iter().map(|cpu| {
-        let name = &cpu.name;
-        let period = cpu.period_ns;
-        let adds = cpu.order.iter().map(|c| {
-            let m = &names.ctrls[c.index()].module;
-            let arg = if ir.controllers[c.index()].hooks.is_empty() {
-                quote!(())
-            } else {
-                quote!(hooks.#m)
-            };
-            if names.ctrls[c.index()].shared {
-                quote!(exec.add(Box::new(#m::new(&gm, #arg)?))?;)
-            } else {
-                quote!(exec.add(Box::new(#m::Controller::new(&gm, #arg)?))?;)
-            }
-        });
-        quote! {{
-            let mut exec = rt::Executive::new(rt::ExecutiveConfig::new(#name, ::core::time::Duration::from_nanos(#period)))?;
-            #(#adds)*
-            executives.push(exec);
-        }}
-    }).collect();
+    // Each CPU's executive and its controllers in cycle order: a line of
+    // `Setup` calls that never return early (`rcs_runtime::setup`).
+    let executives: Vec<TokenStream> = ir
+        .schedule
+        .iter()
+        .map(|cpu| {
+            let name = &cpu.name;
+            let period = cpu.period_ns;
+            let adds = cpu.order.iter().map(|c| {
+                let m = &names.ctrls[c.index()].module;
+                let arg = if ir.controllers[c.index()].hooks.is_empty() {
+                    quote!(())
+                } else {
+                    quote!(hooks.#m)
+                };
+                if names.ctrls[c.index()].shared {
+                    quote!(setup.add(exec, #m::boxed(setup.gm(), #m::INSTANCE, #arg));)
+                } else {
+                    quote!(setup.add(exec, #m::boxed(setup.gm(), #arg));)
+                }
+            });
+            quote! {{
+                let exec = setup.executive(#name, #period);
+                #(#adds)*
+            }}
+        })
+        .collect();
     let system_doc = format!(
         " The `{}` system: Global Memory, its executives and the handles the outside world uses.",
         ir.system
@@ -171,11 +176,11 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
         quote! {
             #[doc = #doc]
             pub fn #get(&self) -> Option<&#m::Controller<#h>> {
-                self.executives.iter().find_map(|e| e.controller_as(#m::NAME))
+                rt::Executive::find_as(&self.executives, #m::NAME)
             }
             #[doc = #doc_mut]
             pub fn #get_mut(&mut self) -> Option<&mut #m::Controller<#h>> {
-                self.executives.iter_mut().find_map(|e| e.controller_as_mut(#m::NAME))
+                rt::Executive::find_as_mut(&mut self.executives, #m::NAME)
             }
         }
     });
@@ -191,24 +196,26 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
             if distributed {
                 (
                     quote!(Option<rt::Writer<#ty>>),
-                    quote!(Some(gm.writer(#name)?)),
+                    quote!(Some(setup.writer(#name))),
                 )
             } else {
-                (quote!(rt::Writer<#ty>), quote!(gm.writer(#name)?))
+                (quote!(rt::Writer<#ty>), quote!(setup.writer(#name)))
             }
         })
         .unzip();
-    let declare_all = quote!(#(gm.declare::<#all_tys>(#all_names)?;)*);
-    let outputs = quote!(Outputs { #(#out_fields: gm.reader(#out_names)?),* });
-    let operators =
-        quote!(Operators { #(#root_fields: rt::Operator::connect(&gm, #root_names)?),* });
+    let buffer_count = all_names.len();
+    let buffer_table = quote! {
+        /// Every Global Memory buffer of the plan set, with its type.
+        const BUFFERS: [rt::BufferDecl; #buffer_count] = [#(rt::BufferDecl::of::<#all_tys>(#all_names)),*];
+    };
+    let outputs = quote!(Outputs { #(#out_fields: setup.reader(#out_names)),* });
+    let operators = quote!(Operators { #(#root_fields: setup.operator(#root_names)),* });
     let process_api = if distributed {
         super::process::process_api(
             ir,
             names,
             &placement,
             &super::process::Shared {
-                declare_all: declare_all.clone(),
                 executives: &executives,
                 outputs: outputs.clone(),
                 operators: operators.clone(),
@@ -222,6 +229,8 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
     };
 
     quote! {
+        #buffer_table
+
         /// Global Memory buffers no controller writes: sensor drivers and
         /// simulators write them through these handles (one writer each).
         #[derive(Debug)]
@@ -268,16 +277,18 @@ pub(crate) fn system(ir: &Ir, names: &Names) -> TokenStream {
             /// Set up Global Memory and the executives, each controller with
             /// its hooks from `hooks`.
             pub fn new(#hooks_param: Hooks #generics) -> Result<Self, rt::SetupError> {
-                let gm = rt::GlobalMemory::new();
-                #declare_all
-                let mut executives = Vec::new();
+                let mut setup = rt::Setup::new(&BUFFERS);
                 #(#executives)*
+                let inputs = Inputs { #(#in_fields: #in_inits),* };
+                let outputs = #outputs;
+                let operators = #operators;
+                let (gm, executives) = setup.finish()?;
                 Ok(Self {
-                    inputs: Inputs { #(#in_fields: #in_inits),* },
-                    outputs: #outputs,
-                    operators: #operators,
                     gm,
                     executives,
+                    inputs,
+                    outputs,
+                    operators,
                     hooks: ::core::marker::PhantomData,
                 })
             }

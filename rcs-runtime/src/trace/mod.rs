@@ -159,6 +159,31 @@ impl TraceSink {
         }
     }
 
+    /// A sink writing to the file `path` (created or truncated, buffered):
+    /// an MCAP recording when its name ends in `.mcap` (feature `mcap`;
+    /// without it such a path is refused as `Unsupported`), else JSON lines.
+    pub fn create(path: &std::path::Path) -> io::Result<Self> {
+        let mcap = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("mcap"));
+        if mcap && cfg!(not(feature = "mcap")) {
+            return Err(io::Error::new(
+                io::ErrorKind::Unsupported,
+                "an .mcap trace needs rcs-runtime's feature `mcap`",
+            ));
+        }
+        let file = io::BufWriter::new(std::fs::File::create(path)?);
+        #[cfg(feature = "mcap")]
+        if mcap {
+            let sink = Self::mcap(file);
+            return match sink.errors {
+                0 => Ok(sink),
+                _ => Err(io::Error::other("the MCAP recording could not be started")),
+            };
+        }
+        Ok(Self::new(file))
+    }
+
     /// A sink writing an MCAP recording to `out` (wrap files in a
     /// `BufWriter`); the recording is whole once [`TraceSink::finish`] ran
     /// or the sink was dropped.

@@ -6,6 +6,7 @@
 //! reader — the PyPI `mcap` package, in a virtual environment under the
 //! target folder — finds one channel per controller and per buffer, JSON
 //! Schemas that name the fields, and one message per traced cycle.
+#![cfg(feature = "mcap")]
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

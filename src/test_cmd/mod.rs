@@ -144,10 +144,13 @@ pub(crate) fn test(args: TestArgs) -> ExitCode {
     }
 
     // The trace is gathered in memory and written whole, through the writer.
-    let mut trace = args
-        .trace
-        .as_ref()
-        .map(|path| Recording::new(&trace_header(), recording::wants_mcap(path)));
+    let mut trace = match &args.trace {
+        None => None,
+        Some(path) => match Recording::new(&trace_header(), recording::wants_mcap(path)) {
+            Ok(r) => Some(r),
+            Err(reason) => return fail(reason),
+        },
+    };
     let (mut passed, mut failed) = (0, 0);
     let mut reports = Vec::new();
     let mut coverage_text = String::new();

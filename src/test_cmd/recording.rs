@@ -62,19 +62,27 @@ pub struct Recording {
 
 impl Recording {
     /// A recording in memory, as MCAP when `mcap`, headed with `header`.
-    pub fn new(header: &rcs_runtime::TraceHeader, mcap: bool) -> Recording {
+    /// `Err`: MCAP asked of an rcsc built without its feature `mcap`.
+    pub fn new(header: &rcs_runtime::TraceHeader, mcap: bool) -> Result<Recording, String> {
         let bytes = TraceBuffer::default();
-        let sink = if mcap {
-            TraceSink::mcap_with_header(bytes.clone(), header)
-        } else {
-            TraceSink::with_header(bytes.clone(), header)
+        let sink = match mcap {
+            #[cfg(feature = "mcap")]
+            true => TraceSink::mcap_with_header(bytes.clone(), header),
+            #[cfg(not(feature = "mcap"))]
+            true => {
+                return Err(
+                    "this rcsc writes no MCAP (built without its default feature `mcap`); name a .jsonl trace or rebuild rcsc with default features"
+                        .to_string(),
+                )
+            }
+            false => TraceSink::with_header(bytes.clone(), header),
         };
-        Recording {
+        Ok(Recording {
             sink,
             bytes,
             base_ns: 0,
             next_base_ns: 0,
-        }
+        })
     }
 
     /// A scenario starts: its cycle 0 comes after every cycle recorded.

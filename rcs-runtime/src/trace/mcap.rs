@@ -352,10 +352,10 @@ pub fn read_mcap(bytes: &[u8]) -> Result<Vec<TraceRecord>, String> {
                 check_header(&h)?;
                 header = Some(h);
             }
-            ::mcap::records::Record::Channel(c) => {
-                if c.metadata.get(KIND_KEY).map(String::as_str) == Some("controller") {
-                    controller_channels.insert(c.id, c.topic);
-                }
+            ::mcap::records::Record::Channel(c)
+                if c.metadata.get(KIND_KEY).map(String::as_str) == Some("controller") =>
+            {
+                controller_channels.insert(c.id, c.topic);
             }
             ::mcap::records::Record::Message { header: m, data } => {
                 if let Some(topic) = controller_channels.get(&m.channel_id) {

@@ -82,24 +82,14 @@ pub struct BufferSample<'a> {
     pub value: &'a serde_json::Value,
 }
 
-/// A controller's message: the record, then what the writer knows beyond.
+/// A controller's message: the record, then what the writer knows beyond
+/// (its time always: the message's log time).
 #[derive(Serialize)]
 struct ControllerMessage<'a, S: AsRef<str> + Serialize> {
     #[serde(flatten)]
     record: &'a TraceRecord<S>,
-    time_ns: u64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    verb_name: Option<&'a str>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    state_name: Option<&'a str>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    status_name: Option<&'a str>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    fired_name: Option<&'a str>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    serial: Option<u32>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    cycle_ns: Option<u64>,
+    #[serde(flatten)]
+    detail: TraceDetail<'a>,
 }
 
 #[derive(Serialize)]
@@ -274,13 +264,10 @@ impl McapTrace {
         let time_ns = detail.time_ns.unwrap_or_else(now_ns);
         let data = serde_json::to_vec(&ControllerMessage {
             record: rec,
-            time_ns,
-            verb_name: detail.verb_name,
-            state_name: detail.state_name,
-            status_name: detail.status_name,
-            fired_name: detail.fired_name,
-            serial: detail.serial,
-            cycle_ns: detail.cycle_ns,
+            detail: TraceDetail {
+                time_ns: Some(time_ns),
+                ..*detail
+            },
         })
         .map_err(io::Error::from)?;
         let i = self.channel(rec.executive.as_ref(), rec.controller.as_ref(), None)?;

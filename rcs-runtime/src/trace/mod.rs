@@ -64,22 +64,31 @@ where
 /// names of its ids (from the plans), the command's serial, the time. The
 /// JSON-lines encoding has no place for it and drops it; MCAP writes each
 /// part that is `Some`.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+/// Serialized as the extra fields of an MCAP controller message, each
+/// left out when `None`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
 pub struct TraceDetail<'a> {
     /// The message's log time, in nanoseconds. `None`: the time of
     /// writing (nanoseconds since the Unix epoch).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub time_ns: Option<u64>,
     /// The verb's name (`GO`).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub verb_name: Option<&'a str>,
     /// The state's name (`S1`, `Waiting`).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub state_name: Option<&'a str>,
     /// The fired row's name (`E3`).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub fired_name: Option<&'a str>,
     /// The status's name (`EXECUTING`).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub status_name: Option<&'a str>,
     /// The serial of the command the status is about.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub serial: Option<u32>,
     /// How long the controller's cycle took, in nanoseconds, when measured.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub cycle_ns: Option<u64>,
 }
 

@@ -67,6 +67,41 @@ fn mcap_and_json_lines_sum_alike() {
     assert!(outputs[1].contains("rows fired"), "{}", outputs[1]);
     assert_eq!(outputs[0], outputs[2], "without --plans");
     assert_eq!(outputs[1], outputs[3], "with --plans");
+    // `rcsc doc --trace` draws the same numbers from either.
+    let mut pages = Vec::new();
+    for sub in ["m", "j"] {
+        let out = rcsc_in(
+            &dir.join(sub),
+            &["doc", s(&plans), "--trace", "run.trace", "-o", "site", "-q"],
+        );
+        assert_ok(&out);
+        pages.push(site_files(&dir.join(sub).join("site")));
+    }
+    assert!(pages[0].len() > 10_000, "a site was written");
+    assert!(pages[0] == pages[1], "the sites differ");
+}
+
+/// Every file below `dir`, by relative path, concatenated in name order.
+fn site_files(dir: &Path) -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    let mut files = Vec::new();
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).into_iter().flatten() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                files.push(p);
+            }
+        }
+    }
+    files.sort();
+    for f in files {
+        out.extend_from_slice(f.strip_prefix(dir).unwrap().to_string_lossy().as_bytes());
+        out.extend(std::fs::read(&f).unwrap());
+    }
+    out
 }
 
 #[test]

@@ -203,3 +203,9 @@ fn topics_keep_to_plain_characters() {
     assert_eq!(topic_part("scenario go/1"), "scenario_go_1");
     assert_eq!(topic_part("PR-2.a"), "PR-2.a");
 }
+
+#[test]
+fn an_mcap_sink_can_move_to_an_executive_thread() {
+    fn send<T: Send>() {}
+    send::<TraceSink>();
+}

@@ -147,7 +147,9 @@ pub(crate) struct TestArgs {
     #[arg(long)]
     pub(crate) coverage: bool,
     /// Write every cycle of every scenario to FILE as a trace (JSON lines,
-    /// docs/trace-format.md), for `rcsc trace` and `rcsc doc --trace`.
+    /// or an MCAP recording for Foxglove, Lichtblick or PlotJuggler when
+    /// FILE ends in .mcap; docs/trace-format.md), for `rcsc trace` and
+    /// `rcsc doc --trace`.
     #[arg(long, value_name = "FILE")]
     pub(crate) trace: Option<PathBuf>,
     /// Where the compiled backend builds its driver [default: $CARGO_TARGET_DIR or ./target]

@@ -34,7 +34,7 @@ The graphs are drawn by Graphviz `dot` (package `graphviz`). Without it the
 site is written with a notice in place of each drawing, and a warning.
 
 --coverage runs each plan set's scenarios (as `rcsc test --coverage`) and
---trace reads traces (as `rcsc trace`): every row then shows how many
+--trace reads traces (as `rcsc trace`; JSON lines or MCAP): every row then shows how many
 cycles fired it, edges are drawn heavier the more they fired, rows that
 never fired are marked, and each state shows the cycles spent in it.
 
@@ -83,7 +83,7 @@ pub(crate) struct DocArgs {
     /// Show the row hits of each plan set's scenarios.
     #[arg(long, conflicts_with = "trace")]
     pub(crate) coverage: bool,
-    /// Show the row hits of these traces (JSON lines).
+    /// Show the row hits of these traces (JSON lines or MCAP).
     #[arg(long, value_name = "FILE", num_args = 1..)]
     pub(crate) trace: Vec<PathBuf>,
     /// Add a Changes page against OLD: a git revision or a path.
@@ -115,7 +115,7 @@ pub(crate) fn doc(args: DocArgs) -> ExitCode {
     } else if !args.trace.is_empty() {
         match trace_cmd::counts_from_traces(&args.trace) {
             Ok(r) => vec![r; irs.len()],
-            Err(reason) => return fail(reason),
+            Err(e) => return e.fail(),
         }
     } else {
         Vec::new()

@@ -1,6 +1,7 @@
-//! `rcsc trace FILE…`: read runtime traces (the JSON lines of
-//! `rcs_runtime::TraceSink`, `rcsc test --trace`, the examples' `--trace`;
-//! docs/trace-format.md) and print per plan how many cycles fired each row
+//! `rcsc trace FILE…`: read runtime traces (the JSON lines or MCAP
+//! recordings of `rcs_runtime::TraceSink`, `rcsc test --trace`, the
+//! examples' `--trace`; docs/trace-format.md), told apart by MCAP's magic
+//! bytes, not by name, and print per plan how many cycles fired each row
 //! and how many ended in each state. The counting is shared with
 //! `rcsc doc --trace`, which draws the same numbers on the graphs.
 
@@ -13,10 +14,11 @@ use std::process::ExitCode;
 
 pub(crate) const TRACE_HELP: &str = "\
 A trace is what an executive's trace sink writes (one JSON line per
-controller per cycle, after a header line; docs/trace-format.md), what
-`rcsc test --trace FILE` writes for scenario runs, or what
-`cargo run -p submarine-example -- --fast --trace FILE` writes. Several
-files are summed.
+controller per cycle, after a header line, or an MCAP recording;
+docs/trace-format.md), what `rcsc test --trace FILE` writes for scenario
+runs (MCAP when FILE ends in .mcap), or what
+`cargo run -p submarine-example -- --fast --trace FILE` writes. Either
+encoding is read, told apart by its first bytes. Several files are summed.
 
 Without --plans, verbs are shown by id and rows as E<position>. With
 --plans, the plans are checked first and rows, states and the rows that
@@ -25,11 +27,12 @@ never fired are named.
 Examples:
   rcsc trace run.jsonl
   rcsc trace run.jsonl --plans plans/submarine
-  rcsc test plans/submarine --trace t.jsonl && rcsc trace t.jsonl --plans plans/submarine";
+  rcsc test plans/submarine --trace t.jsonl && rcsc trace t.jsonl --plans plans/submarine
+  rcsc test plans/submarine --trace t.mcap && rcsc trace t.mcap --plans plans/submarine";
 
 #[derive(clap::Args)]
 pub(crate) struct TraceArgs {
-    /// Trace files (JSON lines).
+    /// Trace files (JSON lines or MCAP).
     #[arg(required = true)]
     pub(crate) files: Vec<PathBuf>,
     /// The plan set(s) the traces ran, to name rows and states.
@@ -39,9 +42,32 @@ pub(crate) struct TraceArgs {
     pub(crate) common: Common,
 }
 
+/// Why a trace file cannot be summed: what, and for a file that is no
+/// readable trace, a code and what to do.
+pub(crate) struct TraceFileError {
+    message: String,
+    coded: Option<(&'static str, &'static str)>,
+}
+
+impl TraceFileError {
+    /// Print it (`error[code]: …` and `= help: …`) and exit 2.
+    pub(crate) fn fail(&self) -> ExitCode {
+        match self.coded {
+            None => fail(&self.message),
+            Some((code, help)) => {
+                let shown = rcs_dsl::render::escape_controls(&self.message);
+                eprintln!("error[{code}]: {shown}");
+                eprintln!("  = help: {help}");
+                ExitCode::from(2)
+            }
+        }
+    }
+}
+
 /// Row hits and cycles per state summed over trace files. `Err`: a file
-/// that cannot be read or is not a trace, with its line.
-pub(crate) fn counts_from_traces(files: &[PathBuf]) -> Result<RunCounts, String> {
+/// that cannot be read or is not a trace, with its line (JSON lines) or
+/// what is wrong in it (MCAP).
+pub(crate) fn counts_from_traces(files: &[PathBuf]) -> Result<RunCounts, TraceFileError> {
     let mut counts = RunCounts {
         source: if files.len() == 1 {
             format!("the trace {}", rcs_dsl::load::display(&files[0]))
@@ -52,9 +78,14 @@ pub(crate) fn counts_from_traces(files: &[PathBuf]) -> Result<RunCounts, String>
     };
     for f in files {
         let shown = rcs_dsl::load::display(f);
-        let text = std::fs::read_to_string(f)
-            .map_err(|e| format!("cannot read the trace {shown}: {e}"))?;
-        let records = rcs_runtime::read_trace(&text).map_err(|e| format!("{shown}: {e}"))?;
+        let bytes = std::fs::read(f).map_err(|e| TraceFileError {
+            message: format!("cannot read the trace {shown}: {e}"),
+            coded: None,
+        })?;
+        let records = rcs_runtime::read_trace_bytes(&bytes).map_err(|e| TraceFileError {
+            message: format!("{shown}: {e}"),
+            coded: Some((e.code(), e.help())),
+        })?;
         for r in records {
             let Some(verb) = r.verb else { continue };
             if let Some(state) = r.state {
@@ -71,7 +102,7 @@ pub(crate) fn counts_from_traces(files: &[PathBuf]) -> Result<RunCounts, String>
 pub(crate) fn trace(args: TraceArgs) -> ExitCode {
     let counts = match counts_from_traces(&args.files) {
         Ok(c) => c,
-        Err(reason) => return fail(reason),
+        Err(e) => return e.fail(),
     };
     let irs = if args.plans.is_empty() {
         Vec::new()

@@ -17,7 +17,7 @@
 //! | `clock` | the executive's per-controller timing from the TSC (`quanta`), falling back to the OS clock |
 //! | [`math`] | the float built-in functions of the language (`sqrt`, `min`, …), shared by generated code and the interpreter |
 //! | [`operator`] | [`Operator`]: command a root controller, read status |
-//! | [`trace`] | optional JSON-lines trace of every controller's cycle |
+//! | [`trace`] | optional trace of every controller's cycle: JSON lines, or MCAP (feature `mcap`) |
 //! | [`schema`] | [`Schema`]: a stable hash of a buffer type's structure |
 //! | [`serde_array`] | serde for arrays of any length (serde itself stops at 32), for generated types |
 //! | [`signal`] | [`CycleSignal`]: an executive wakes a thread off the cycle path (the bridge's export) |
@@ -237,7 +237,10 @@ pub use schema::Schema;
 pub use serde;
 pub use setup::{BufferDecl, Ports, Setup};
 pub use signal::CycleSignal;
-pub use trace::{read_trace, TraceError, TraceHeader, TraceRecord, TraceSink, TRACE_VERSION};
+pub use trace::{
+    read_trace, read_trace_bytes, TraceDetail, TraceError, TraceHeader, TraceReadError,
+    TraceRecord, TraceSink, TRACE_VERSION,
+};
 pub use watchdog::BufferWatch;
 
 /// Include the Rust code `rcsc` generated for a plan set from a build script.

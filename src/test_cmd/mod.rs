@@ -7,22 +7,24 @@
 //! beside it, `files` which scenario files test which plan set and reading
 //! them, `run` running a plan set's scenarios and reporting each, `system`
 //! running a system scenario, `coverage` the rows no scenario fired and
-//! the counts `rcsc doc --coverage` draws.
+//! the counts `rcsc doc --coverage` draws, `recording` the trace of
+//! `--trace` (JSON lines or MCAP).
 
 mod coverage;
 mod files;
+mod recording;
 mod run;
 mod system;
 
 pub use coverage::{coverage, scenario_counts};
 pub use files::{assign, load, targets};
+pub use recording::Recording;
 pub use run::{run_set, Fired};
 
 use crate::args::*;
 use crate::commands::check_sets_to_run;
 use crate::output::*;
 use crate::{compiled, Status};
-use rcs_runtime::TraceSink;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -51,41 +53,12 @@ fn shown(text: &str) -> std::borrow::Cow<'_, str> {
 }
 
 /// The header of `rcsc test --trace`: the generated marker in the first
-/// line lets the next run replace the file.
+/// line (in MCAP, the header's `library` field) lets the next run replace
+/// the file.
 fn trace_header() -> rcs_runtime::TraceHeader {
     rcs_runtime::TraceHeader {
         generated: Some(format!("{} test --trace", rcs_codegen::GENERATED)),
         ..rcs_runtime::TraceHeader::current()
-    }
-}
-
-/// The bytes of a trace being written, shared with the sink (which owns
-/// its writer).
-#[derive(Clone, Default)]
-struct TraceBuffer(std::sync::Arc<std::sync::Mutex<Vec<u8>>>);
-
-impl TraceBuffer {
-    /// The trace so far, as text (records are JSON: always UTF-8).
-    fn take(&self) -> String {
-        let bytes = match self.0.lock() {
-            Ok(mut b) => std::mem::take(&mut *b),
-            Err(poisoned) => std::mem::take(&mut *poisoned.into_inner()),
-        };
-        String::from_utf8_lossy(&bytes).into_owned()
-    }
-}
-
-impl std::io::Write for TraceBuffer {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        match self.0.lock() {
-            Ok(mut b) => b.extend_from_slice(buf),
-            Err(poisoned) => poisoned.into_inner().extend_from_slice(buf),
-        }
-        Ok(buf.len())
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        Ok(())
     }
 }
 
@@ -171,11 +144,13 @@ pub(crate) fn test(args: TestArgs) -> ExitCode {
     }
 
     // The trace is gathered in memory and written whole, through the writer.
-    let trace_bytes = TraceBuffer::default();
-    let mut trace = args
-        .trace
-        .as_ref()
-        .map(|_| TraceSink::with_header(trace_bytes.clone(), &trace_header()));
+    let mut trace = match &args.trace {
+        None => None,
+        Some(path) => match Recording::new(&trace_header(), recording::wants_mcap(path)) {
+            Ok(r) => Some(r),
+            Err(reason) => return fail(reason),
+        },
+    };
     let (mut passed, mut failed) = (0, 0);
     let mut reports = Vec::new();
     let mut coverage_text = String::new();
@@ -218,12 +193,11 @@ pub(crate) fn test(args: TestArgs) -> ExitCode {
         }
     }
     if let (Some(t), Some(path)) = (trace, &args.trace) {
-        if t.errors() > 0 {
-            return fail("the trace could not be written whole (a write failed)");
-        }
-        drop(t);
-        let text = trace_bytes.take();
-        if let Err(e) = rcs_codegen::writer::write_file(path, &text, &inputs, &mut |_| {}) {
+        let bytes = match t.finish() {
+            Ok(b) => b,
+            Err(reason) => return fail(reason),
+        };
+        if let Err(e) = rcs_codegen::writer::write_file_bytes(path, &bytes, &inputs, &mut |_| {}) {
             return write_failed(&e);
         }
     }

@@ -4,12 +4,12 @@
 //! System scenarios are run by `super::system`.
 
 use super::files::Loaded;
+use super::recording::Recording;
 use super::system::run_system;
 use crate::compiled;
 use rcs_codegen::site::RunCounts;
 use rcs_dsl::ir::Ir;
 use rcs_dsl::scenario::{self, AnyScenario, Outcome};
-use rcs_runtime::{TraceRecord, TraceSink};
 
 /// The rows fired, cycle by cycle, with runs of one name shortened
 /// (`- ×200`), so a long wait reads as one item.
@@ -62,7 +62,7 @@ pub fn run_set(
     loaded: &[Loaded],
     mut remote: Option<(&mut compiled::Driver, usize)>,
     fired: &mut Fired,
-    mut trace: Option<&mut TraceSink>,
+    mut trace: Option<&mut Recording>,
 ) -> Result<Vec<ScenarioResult>, String> {
     let mut results = Vec::new();
     for l in loaded {
@@ -87,19 +87,12 @@ pub fn run_set(
         };
         let name = &ir.controller(s.controller).name;
         let executive = format!("scenario {}", s.name);
+        if let Some(t) = trace.as_deref_mut() {
+            t.start_scenario();
+        }
         let mut on_cycle = |rec: &rcs_runtime::driver::Record, new_command: bool| {
             if let Some(t) = trace.as_deref_mut() {
-                t.write(&TraceRecord {
-                    executive: executive.as_str(),
-                    cycle: rec.cycle,
-                    controller: name.as_str(),
-                    verb: rec.verb,
-                    state: rec.verb.map(|_| rec.state),
-                    status: Some(rec.status.0),
-                    error: Some(rec.error.0),
-                    fired: rec.fired,
-                    new_command,
-                });
+                t.cycle(ir, s.controller, &executive, rec, new_command);
             }
         };
         let outcome = match remote.as_mut() {

@@ -2,11 +2,11 @@
 //! for `rcsc test`: on the interpreter or the compiled driver, with the
 //! rows of every controller of the run counted and its failure report.
 
+use super::recording::Recording;
 use super::run::{fired_so_far, Fired, ScenarioResult};
 use crate::compiled;
 use rcs_dsl::ir::Ir;
 use rcs_dsl::scenario::{self, SystemOutcome};
-use rcs_runtime::{TraceRecord, TraceSink};
 
 /// Run one system scenario (on the interpreter, or on the generated
 /// code's `SystemDriver` through the driver process), count its rows for
@@ -17,26 +17,20 @@ pub(super) fn run_system(
     s: &scenario::SystemScenario,
     remote: &mut Option<(&mut compiled::Driver, usize)>,
     fired: &mut Fired,
-    trace: &mut Option<&mut TraceSink>,
+    trace: &mut Option<&mut Recording>,
 ) -> Result<ScenarioResult, String> {
     let executive = format!("scenario {}", s.name);
+    if let Some(t) = trace.as_deref_mut() {
+        t.start_scenario();
+    }
     let mut echoes = std::collections::BTreeMap::new();
     let mut on_cycle = |c: rcs_dsl::ir::CtrlId, rec: &rcs_runtime::driver::Record| {
         // A new command is one whose serial the controller now echoes.
         let before = echoes.insert(c, rec.echo_serial);
         if let Some(t) = trace.as_deref_mut() {
-            t.write(&TraceRecord {
-                executive: executive.as_str(),
-                cycle: rec.cycle,
-                controller: ir.controller(c).name.as_str(),
-                verb: rec.verb,
-                state: rec.verb.map(|_| rec.state),
-                status: Some(rec.status.0),
-                error: Some(rec.error.0),
-                fired: rec.fired,
-                new_command: before.is_some_and(|b| b != rec.echo_serial)
-                    || before.is_none() && rec.echo_serial != 0,
-            });
+            let new_command = before.is_some_and(|b| b != rec.echo_serial)
+                || before.is_none() && rec.echo_serial != 0;
+            t.cycle(ir, c, &executive, rec, new_command);
         }
     };
     let outcome = match remote.as_mut() {

@@ -64,7 +64,8 @@ const USAGE: &str = "usage: submarine [--fast [CYCLES]] [--speed KNOTS] [--every
   --speed KNOTS     the speed to order: SM <- TRANSIT(speed: KNOTS) (default 15)
   --every CYCLES    print a table row every CYCLES cycles (default 2)
   --hold CYCLES     after AT_GOAL, keep running CYCLES more cycles to show the speed holds (default 0)
-  --trace FILE      write every controller's cycles to FILE (JSON lines, docs/trace-format.md;
+  --trace FILE      write every controller's cycles to FILE (JSON lines, or MCAP when FILE
+                    ends in .mcap; docs/trace-format.md;
                     `rcsc trace FILE` sums them up); also the RCSC_TRACE environment variable";
 
 // ---------------------------------------------------------------------------
@@ -321,8 +322,8 @@ fn main() -> ExitCode {
     };
     let trace = match &opts.trace {
         None => None,
-        Some(path) => match std::fs::File::create(path) {
-            Ok(f) => Some(rcs_runtime::TraceSink::new(std::io::BufWriter::new(f))),
+        Some(path) => match rcs_runtime::TraceSink::create(path) {
+            Ok(sink) => Some(sink),
             Err(e) => {
                 eprintln!("submarine: cannot write the trace {}: {e}", path.display());
                 return ExitCode::from(2);
@@ -455,7 +456,7 @@ fn run(
     }
 
     if let Some(mut sink) = system.executives[0].take_trace() {
-        if sink.flush().is_err() || sink.errors() > 0 {
+        if sink.finish().is_err() || sink.errors() > 0 {
             eprintln!("submarine: the trace could not be written whole");
         }
     }

@@ -83,19 +83,51 @@ pub(super) fn inspect(root: &Path, out_dir: &Path, rel: &str) -> Result<Existing
     Ok(Existing::Nothing)
 }
 
-/// Whether the first line of a file carries the [`GENERATED`] marker.
+/// How much of a file [`is_generated`] reads: the first line of a text
+/// file, or the header record of an MCAP recording.
+const HEAD: usize = 512;
+
+/// Whether the first line of a file (the header of an MCAP recording)
+/// carries the [`GENERATED`] marker.
 pub fn is_generated(path: &Path) -> bool {
-    let mut head = Vec::with_capacity(512);
-    let read = std::fs::File::open(path).and_then(|f| f.take(512).read_to_end(&mut head));
+    let mut head = Vec::with_capacity(HEAD);
+    let read = std::fs::File::open(path).and_then(|f| f.take(HEAD as u64).read_to_end(&mut head));
     read.is_ok() && first_line_generated(&head)
 }
 
-/// Whether these bytes start with a line carrying [`GENERATED`] (pure).
+/// Whether these bytes start with a line carrying [`GENERATED`] or, for
+/// an MCAP recording (whose magic bytes end in a newline), whether its
+/// header's `library` field carries it (pure).
 pub(super) fn first_line_generated(bytes: &[u8]) -> bool {
-    let first = bytes.split(|&b| b == b'\n').next().unwrap_or(&[]);
+    let first = match mcap_library(bytes) {
+        Some(library) => library,
+        None => bytes.split(|&b| b == b'\n').next().unwrap_or(&[]),
+    };
     first
         .windows(GENERATED.len())
         .any(|w| w == GENERATED.as_bytes())
+}
+
+/// MCAP's magic bytes.
+const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
+
+/// The `library` field of an MCAP file's header record, which follows the
+/// magic bytes: opcode 0x01, the record's length (u64), then `profile` and
+/// `library`, each a u32 length and its bytes, little-endian (pure).
+/// `None`: not MCAP, or too short to hold the field.
+fn mcap_library(bytes: &[u8]) -> Option<&[u8]> {
+    let header = bytes.strip_prefix(MCAP_MAGIC)?;
+    if *header.first()? != 0x01 {
+        return None;
+    }
+    let string_at = |at: usize| -> Option<(&[u8], usize)> {
+        let len: [u8; 4] = header.get(at..at + 4)?.try_into().ok()?;
+        let len = usize::try_from(u32::from_le_bytes(len)).ok()?;
+        let start = at + 4;
+        Some((header.get(start..start.checked_add(len)?)?, start + len))
+    };
+    let (_profile, next) = string_at(1 + 8)?;
+    string_at(next).map(|(library, _)| library)
 }
 
 /// Generated regular files below `dir` that are not in `keep` (relative

@@ -5,7 +5,8 @@
 //! A named file is written like a file of a build, in the folder that
 //! holds it: under that folder's lock, checked before anything changes (a
 //! folder or a link to nothing in its place is refused, an existing file
-//! must carry [`GENERATED`](crate::GENERATED) in its first line), staged
+//! must carry [`GENERATED`](crate::GENERATED) in its first line, or an
+//! MCAP recording in its header's `library` field), staged
 //! to a temporary beside it and renamed over it. What differs: the user
 //! chose the path, so a symbolic link there is followed wherever it leads
 //! (the file replaced is the one it names), and the folder is not swept
@@ -129,6 +130,17 @@ pub fn write_file(
     inputs: &Inputs,
     blocked: &mut dyn FnMut(&Path),
 ) -> Result<WriteReport, WriteError> {
+    write_file_bytes(path, contents.as_bytes(), inputs, blocked)
+}
+
+/// [`write_file`] for bytes that are not text (an MCAP recording, whose
+/// marker is in its header's `library` field).
+pub fn write_file_bytes(
+    path: &Path,
+    contents: &[u8],
+    inputs: &Inputs,
+    blocked: &mut dyn FnMut(&Path),
+) -> Result<WriteReport, WriteError> {
     if path.file_name().is_none() || path.as_os_str().is_empty() {
         return Err(WriteError::InTheWay {
             path: path.display().to_string(),
@@ -162,7 +174,7 @@ pub fn write_file(
     };
     check_file(path, inputs)?;
     let target = dir.join(&name);
-    if existing(&target)?.is_some_and(|old| old == contents.as_bytes()) {
+    if existing(&target)?.is_some_and(|old| old == contents) {
         report.unchanged.push(path.to_path_buf());
         return Ok(report);
     }
@@ -171,7 +183,7 @@ pub fn write_file(
         .write(true)
         .create_new(true)
         .open(&tmp)
-        .and_then(|mut f| f.write_all(contents.as_bytes()));
+        .and_then(|mut f| f.write_all(contents));
     if let Err(e) = staged.and_then(|()| std::fs::rename(&tmp, &target)) {
         let _ = std::fs::remove_file(&tmp);
         return Err(io_err(&target, e));

@@ -44,7 +44,7 @@ use crate::handshake::ErrorCode;
 pub use crate::heartbeat::{Heartbeat, Wait, MAX_PERIOD};
 use crate::plan::{Bookkeeping, SampleStats, Tick};
 use crate::signal::CycleSignal;
-use crate::trace::{TraceRecord, TraceSink};
+use crate::trace::{TraceDetail, TraceRecord, TraceSink};
 
 /// What the executive tells a controller about the cycle it runs in.
 #[derive(Debug, Clone, Copy)]
@@ -483,6 +483,7 @@ impl Executive {
                         message,
                     });
             }
+            let mut cycle_ns = None;
             if let (Some(clock), Some(start)) = (&self.clock, &start) {
                 // `max`: a counter read behind the last one (the thread
                 // moved to a core whose TSC lags) counts as 0 ns and keeps
@@ -490,6 +491,7 @@ impl Executive {
                 let t1_ns = clock.elapsed_ns(start).max(t0_ns);
                 let ns = t1_ns - t0_ns;
                 slot.stats.exec_ns.record(ns);
+                cycle_ns = Some(ns);
                 if ns > self.period_ns {
                     slot.stats.overruns = slot.stats.overruns.saturating_add(1);
                 }
@@ -498,17 +500,25 @@ impl Executive {
             }
             if let Some(trace) = &mut self.trace {
                 let bk = slot.ctrl.bookkeeping();
-                trace.write(&TraceRecord {
-                    executive: &self.name,
-                    cycle,
-                    controller: &slot.name,
-                    verb: bk.map(|b| b.verb()),
-                    state: bk.map(|b| b.state()),
-                    status: bk.map(|b| b.status().0),
-                    error: bk.map(|b| b.error().0),
-                    fired: bk.and_then(|b| b.fired()),
-                    new_command: bk.is_some_and(|b| b.new_command()),
-                });
+                let detail = TraceDetail {
+                    cycle_ns,
+                    serial: bk.map(|b| b.echo_serial()),
+                    ..TraceDetail::default()
+                };
+                trace.write_with(
+                    &TraceRecord {
+                        executive: &self.name,
+                        cycle,
+                        controller: &slot.name,
+                        verb: bk.map(|b| b.verb()),
+                        state: bk.map(|b| b.state()),
+                        status: bk.map(|b| b.status().0),
+                        error: bk.map(|b| b.error().0),
+                        fired: bk.and_then(|b| b.fired()),
+                        new_command: bk.is_some_and(|b| b.new_command()),
+                    },
+                    &detail,
+                );
             }
         }
         let ns = if start.is_some() {

@@ -21,7 +21,11 @@ impl Controller for Idle {
 
 /// Run two controllers for 5 cycles, tracing to `path`; the trace's bytes.
 fn run(path: &std::path::Path) -> Vec<u8> {
-    let config = ExecutiveConfig::new("main", Duration::from_millis(10)).with_measure(false);
+    run_measured(path, false)
+}
+
+fn run_measured(path: &std::path::Path, measure: bool) -> Vec<u8> {
+    let config = ExecutiveConfig::new("main", Duration::from_millis(10)).with_measure(measure);
     let mut e = Executive::new(config).unwrap();
     e.add(Box::new(Idle("SIM"))).unwrap();
     e.add(Box::new(Idle("DRV"))).unwrap();
@@ -48,5 +52,25 @@ fn an_executive_records_mcap_for_a_dot_mcap_path() {
     assert_eq!(from_mcap[9].cycle, 4);
     assert_eq!(from_mcap[9].controller, "DRV");
     assert_eq!(from_mcap[9].verb, None);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// With timing on, each controller message carries the cycle's time
+/// (`cycle_ns`), and without it none does.
+#[test]
+fn a_measured_executive_records_each_cycle_time() {
+    let dir = std::env::temp_dir().join(format!("rcs-runtime-trace-ns-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for measure in [true, false] {
+        let bytes = run_measured(&dir.join("run.mcap"), measure);
+        let mut messages = 0;
+        for m in mcap::MessageStream::new(&bytes).unwrap() {
+            let m = m.unwrap();
+            let json: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+            assert_eq!(json["cycle_ns"].is_u64(), measure, "{json}");
+            messages += 1;
+        }
+        assert_eq!(messages, 10);
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

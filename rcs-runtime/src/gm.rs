@@ -181,12 +181,7 @@ impl GlobalMemory {
         &self,
         ctrl: &str,
     ) -> Result<Writer<CommandBuffer<C>>, SetupError> {
-        let (cell, name) =
-            self.command_handle_erased(ctrl, TypeKey::of::<CommandBuffer<C>>(), true)?;
-        Ok(Writer {
-            cell: typed_cell(cell, &name)?,
-            name,
-        })
+        self.writer(&command_buffer_name(ctrl))
     }
 
     /// A reader of `ctrl`'s command buffer (the controller itself reads it).
@@ -194,21 +189,7 @@ impl GlobalMemory {
         &self,
         ctrl: &str,
     ) -> Result<Reader<CommandBuffer<C>>, SetupError> {
-        let (cell, name) =
-            self.command_handle_erased(ctrl, TypeKey::of::<CommandBuffer<C>>(), false)?;
-        Ok(Reader {
-            cell: typed_cell(cell, &name)?,
-            name,
-        })
-    }
-
-    fn command_handle_erased(
-        &self,
-        ctrl: &str,
-        key: TypeKey,
-        writer: bool,
-    ) -> Result<(AnyCell, Arc<str>), SetupError> {
-        self.handle_erased(&command_buffer_name(ctrl), key, writer)
+        self.reader(&command_buffer_name(ctrl))
     }
 
     /// [`Setup`](crate::Setup)'s way to a handle: the cell of buffer `name`
@@ -296,6 +277,11 @@ impl TypeKey {
 }
 
 fn new_cell<T: BufferData>() -> AnyCell {
+    fresh_cell::<T>()
+}
+
+/// A new cell holding `T::default()`, never written.
+fn fresh_cell<T: BufferData>() -> Arc<Cell<T>> {
     Arc::new(Cell::<T>::new((T::default(), 0)))
 }
 
@@ -332,7 +318,7 @@ fn typed_cell<T: BufferData>(cell: AnyCell, name: &str) -> Result<Arc<Cell<T>>, 
 pub(crate) fn cell_or_stand_in<T: BufferData>(cell: AnyCell) -> Arc<Cell<T>> {
     match cell.downcast::<Cell<T>>() {
         Ok(cell) => cell,
-        Err(_) => Arc::new(Cell::<T>::new((T::default(), 0))),
+        Err(_) => fresh_cell(),
     }
 }
 

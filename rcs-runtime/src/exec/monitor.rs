@@ -176,6 +176,16 @@ impl ControllerMonitor {
         self.hits.get(i).map(|h| h.load(Ordering::Relaxed))
     }
 
+    /// The verbs its hit counters cover (ids `0..verbs()`).
+    pub fn verbs(&self) -> usize {
+        self.hits.len().checked_div(self.rows_per_verb).unwrap_or(0)
+    }
+
+    /// The rows per verb its hit counters cover.
+    pub fn rows_per_verb(&self) -> usize {
+        self.rows_per_verb
+    }
+
     /// Rows fired that had no counter (a plan longer than the room given
     /// to [`Executive::attach_monitor`]).
     pub fn hits_dropped(&self) -> u64 {

@@ -41,6 +41,9 @@ pub struct ControllerSnapshot {
     pub name: String,
     /// The CPU that runs it.
     pub cpu: String,
+    /// Whether it runs plans (a simulator or driver does not: its verb,
+    /// state, status and error mean nothing).
+    pub has_plans: bool,
     /// The verb it works on.
     pub verb: VerbId,
     /// Its plan's current state.
@@ -174,6 +177,9 @@ impl Model {
             Some(i) => (i.status_name(c.status), i.error_name(c.error)),
             None => (format!("status {}", c.status.0), format!("{}", c.error.0)),
         };
+        if !c.has_plans {
+            return ("-".into(), "-".into(), "-".into(), "-".into());
+        }
         if c.status == Status::NOT_READY {
             return ("-".into(), "-".into(), status, error);
         }
@@ -181,9 +187,11 @@ impl Model {
     }
 
     /// The active plan of controller `name`: the verb's name, its table and
-    /// each row ready to draw.
+    /// each row ready to draw (`None` before its first command).
     pub fn plan_rows(&self, name: &str) -> Option<(String, &PlanTable, Vec<PlanRowView>)> {
-        let c = self.controller(name)?;
+        let c = self
+            .controller(name)
+            .filter(|c| c.has_plans && c.status != Status::NOT_READY)?;
         let verb = self
             .catalog
             .controller(name)?

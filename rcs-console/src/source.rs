@@ -132,6 +132,7 @@ impl Source for InProcess {
                 snap.controllers.push(ControllerSnapshot {
                     name: c.name().to_owned(),
                     cpu: m.name().to_owned(),
+                    has_plans: f.has_plans,
                     verb: f.verb,
                     state: f.state,
                     status: f.status,

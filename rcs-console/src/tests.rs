@@ -53,6 +53,7 @@ fn snapshot(hits: u64) -> Snapshot {
     let ctrl = |name: &str, verb, state, status, last| ControllerSnapshot {
         name: name.into(),
         cpu: "main".into(),
+        has_plans: true,
         verb,
         state,
         status,

@@ -237,7 +237,7 @@ fn draw_plan(frame: &mut Frame, app: &App, area: Rect) {
     let (_, state, ..) = app.model.names(&name);
     let Some((verb, _, rows)) = app.model.plan_rows(&name) else {
         frame.render_widget(
-            Paragraph::new("no active plan").block(
+            Paragraph::new("no active plan (no command yet, or a controller without plans)").block(
                 Block::new()
                     .borders(Borders::ALL)
                     .title(format!("{name}: plan")),
@@ -274,7 +274,7 @@ fn draw_plan(frame: &mut Frame, app: &App, area: Rect) {
         Constraint::Length(5),
         Constraint::Length(8),
         Constraint::Fill(1),
-        Constraint::Length(24),
+        Constraint::Length(26),
         Constraint::Length(6),
     ];
     let header = Row::new(vec![" row", "from", "when", "to", "hits"])

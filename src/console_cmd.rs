@@ -10,7 +10,6 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use rcs_console::catalog::ParamType;
 use rcs_console::Catalog;
 
 use crate::output::fail;
@@ -94,7 +93,7 @@ fn summary(catalog: &Catalog) -> String {
                 let params: Vec<String> = v
                     .params
                     .iter()
-                    .map(|(n, t)| format!("{n}: {}", type_name(t)))
+                    .map(|(n, t)| format!("{n}: {}", t.name()))
                     .collect();
                 format!("{}({})", v.name, params.join(", "))
             })
@@ -106,14 +105,6 @@ fn summary(catalog: &Catalog) -> String {
         ));
     }
     out
-}
-
-fn type_name(t: &ParamType) -> String {
-    match t {
-        ParamType::Bool => "bool".into(),
-        ParamType::Int(n, ..) | ParamType::Float(n) => (*n).into(),
-        ParamType::Enum(n, _) | ParamType::Other(n) => n.clone(),
-    }
 }
 
 #[cfg(test)]

@@ -74,7 +74,13 @@ fn cargo() -> Command {
 }
 
 /// The crates `cargo publish --workspace` uploads, in dependency order.
-const PUBLISHED: [&str; 4] = ["rcs-runtime", "rcs-dsl", "rcs-codegen", "rcsc"];
+const PUBLISHED: [&str; 5] = [
+    "rcs-runtime",
+    "rcs-dsl",
+    "rcs-codegen",
+    "rcs-console",
+    "rcsc",
+];
 
 /// The workspace's members with `publish` unset: the published ones.
 fn publishable_members() -> Vec<String> {
@@ -175,7 +181,7 @@ fn check_package_contents() {
         }
     }
     // The licenses in each package folder are the root's, word for word.
-    for package in ["rcs-runtime", "rcs-dsl", "rcs-codegen"] {
+    for package in ["rcs-runtime", "rcs-dsl", "rcs-codegen", "rcs-console"] {
         for license in ["LICENSE-MIT", "LICENSE-APACHE"] {
             assert_eq!(
                 std::fs::read_to_string(repo().join(package).join(license)).unwrap(),

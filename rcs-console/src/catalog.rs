@@ -51,6 +51,17 @@ pub enum ParamType {
     Other(String),
 }
 
+impl ParamType {
+    /// The type's name as the plans write it (`f64`, `Direction`).
+    pub fn name(&self) -> &str {
+        match self {
+            ParamType::Bool => "bool",
+            ParamType::Int(n, ..) | ParamType::Float(n) => n,
+            ParamType::Enum(n, _) | ParamType::Other(n) => n,
+        }
+    }
+}
+
 /// A parameter value, checked against its [`ParamType`].
 #[derive(Debug, Clone, PartialEq)]
 pub enum ArgValue {

@@ -113,7 +113,7 @@ pub fn draw(frame: &mut Frame, app: &App) {
                             let params: Vec<String> = v
                                 .params
                                 .iter()
-                                .map(|(n, t)| format!("{n}: {}", type_text(t)))
+                                .map(|(n, t)| format!("{n}: {}", t.name()))
                                 .collect();
                             let mark = if i == *cursor { ">" } else { " " };
                             format!("{mark} {}({})", v.name, params.join(", "))
@@ -124,15 +124,6 @@ pub fn draw(frame: &mut Frame, app: &App) {
             draw_popup(frame, &format!("command {root}: pick a verb, Enter"), verbs);
         }
         _ => {}
-    }
-}
-
-fn type_text(t: &crate::catalog::ParamType) -> String {
-    use crate::catalog::ParamType;
-    match t {
-        ParamType::Bool => "bool".into(),
-        ParamType::Int(n, ..) | ParamType::Float(n) => (*n).into(),
-        ParamType::Enum(n, _) | ParamType::Other(n) => n.clone(),
     }
 }
 
@@ -156,7 +147,7 @@ pub fn prompt_line(app: &App) -> String {
                 Some((v, (name, ty))) => format!(
                     "{root} <- {}: {name} ({}) = {input}_   {}",
                     v.name,
-                    type_text(ty),
+                    ty.name(),
                     app.message
                 ),
                 None => app.message.clone(),

@@ -280,13 +280,14 @@ fn rcsc_installed_from_its_packages_runs_the_compiled_backend() {
     // reads no configuration from the current folder, so it comes by
     // `--config FILE`.
     let mut patch = String::from("[patch.crates-io]\n");
-    for (name, dir) in &unpacked[..3] {
+    let (rcsc_entry, libraries) = unpacked.split_last().expect("rcsc is packaged last");
+    for (name, dir) in libraries {
         let dir = dir.to_str().unwrap().replace('\\', "/");
         patch.push_str(&format!("{name} = {{ path = {dir:?} }}\n"));
     }
     let config = tmp.join("patch.toml");
     std::fs::write(&config, patch).unwrap();
-    let (_, rcsc_package) = &unpacked[3];
+    let (_, rcsc_package) = rcsc_entry;
     let root = tmp.join("root");
 
     let started = Instant::now();

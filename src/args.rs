@@ -53,6 +53,10 @@ pub(crate) enum Command {
     /// Make a development CA and per-process certificates for a distributed plan set.
     #[command(after_help = crate::certs_cmd::CERTS_HELP)]
     Certs(crate::certs_cmd::CertsArgs),
+    /// Watch and act on a running system: the operator's console (in-process today).
+    #[cfg(feature = "console")]
+    #[command(after_help = crate::console_cmd::CONSOLE_HELP)]
+    Console(crate::console_cmd::ConsoleArgs),
     /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
     #[command(after_help = crate::completions::COMPLETIONS_HELP)]
     Completions(crate::completions::CompletionsArgs),

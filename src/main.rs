@@ -11,6 +11,8 @@ mod certs_cmd;
 mod commands;
 mod compiled;
 mod completions;
+#[cfg(feature = "console")]
+mod console_cmd;
 mod diff_cmd;
 mod doc_cmd;
 mod output;
@@ -34,6 +36,8 @@ fn main() -> ExitCode {
         Command::Doc(args) => doc_cmd::doc(args),
         Command::Trace(args) => trace_cmd::trace(args),
         Command::Certs(args) => certs_cmd::certs(args),
+        #[cfg(feature = "console")]
+        Command::Console(args) => console_cmd::console(args),
         Command::Completions(args) => completions::completions(args),
         Command::Man(args) => completions::man(args),
     }

@@ -12,7 +12,7 @@ mod common;
 use common::{rcsc, scratch, text};
 
 /// Every subcommand the pages and the scripts must know.
-const SUBCOMMANDS: [&str; 11] = [
+const SUBCOMMANDS: [&str; 12] = [
     "check",
     "build",
     "graph",
@@ -22,6 +22,7 @@ const SUBCOMMANDS: [&str; 11] = [
     "doc",
     "trace",
     "certs",
+    "console",
     "completions",
     "man",
 ];

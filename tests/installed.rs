@@ -74,7 +74,13 @@ fn cargo() -> Command {
 }
 
 /// The crates `cargo publish --workspace` uploads, in dependency order.
-const PUBLISHED: [&str; 4] = ["rcs-runtime", "rcs-dsl", "rcs-codegen", "rcsc"];
+const PUBLISHED: [&str; 5] = [
+    "rcs-runtime",
+    "rcs-dsl",
+    "rcs-codegen",
+    "rcs-console",
+    "rcsc",
+];
 
 /// The workspace's members with `publish` unset: the published ones.
 fn publishable_members() -> Vec<String> {
@@ -175,7 +181,7 @@ fn check_package_contents() {
         }
     }
     // The licenses in each package folder are the root's, word for word.
-    for package in ["rcs-runtime", "rcs-dsl", "rcs-codegen"] {
+    for package in ["rcs-runtime", "rcs-dsl", "rcs-codegen", "rcs-console"] {
         for license in ["LICENSE-MIT", "LICENSE-APACHE"] {
             assert_eq!(
                 std::fs::read_to_string(repo().join(package).join(license)).unwrap(),
@@ -274,13 +280,14 @@ fn rcsc_installed_from_its_packages_runs_the_compiled_backend() {
     // reads no configuration from the current folder, so it comes by
     // `--config FILE`.
     let mut patch = String::from("[patch.crates-io]\n");
-    for (name, dir) in &unpacked[..3] {
+    let (rcsc_entry, libraries) = unpacked.split_last().expect("rcsc is packaged last");
+    for (name, dir) in libraries {
         let dir = dir.to_str().unwrap().replace('\\', "/");
         patch.push_str(&format!("{name} = {{ path = {dir:?} }}\n"));
     }
     let config = tmp.join("patch.toml");
     std::fs::write(&config, patch).unwrap();
-    let (_, rcsc_package) = &unpacked[3];
+    let (_, rcsc_package) = rcsc_entry;
     let root = tmp.join("root");
 
     let started = Instant::now();

@@ -28,6 +28,9 @@
 //! A [`CycleSignal`] attached with [`Executive::set_cycle_signal`] is raised
 //! at the end of every cycle (lock- and allocation-free): the Zenoh bridge
 //! publishes the cycle's writes then instead of polling for them.
+//! An [`ExecutiveMonitor`] attached with [`Executive::attach_monitor`]
+//! publishes each controller's figures in atomics for a console on another
+//! thread (no lock, no allocation on the cycle path).
 
 use std::any::Any;
 use std::io;
@@ -268,6 +271,8 @@ pub struct Executive {
     /// Panics caught since the last `step`/`run_cycles` reported them.
     fault: Option<CycleFault>,
     signal: Option<CycleSignal>,
+    /// Figures published for a console ([`Executive::attach_monitor`]).
+    monitor: Option<Arc<ExecutiveMonitor>>,
 }
 
 impl std::fmt::Debug for Executive {
@@ -308,6 +313,7 @@ impl Executive {
             trace: None,
             fault: None,
             signal: None,
+            monitor: None,
         })
     }
 
@@ -426,6 +432,7 @@ impl Executive {
             let late = self.heartbeat.wait();
             self.stats.lateness_ns.record(nanos(late));
             self.stats.missed_heartbeats = self.heartbeat.missed();
+            self.publish_executive();
             self.shared
                 .missed
                 .store(self.heartbeat.missed(), Ordering::Release);
@@ -455,7 +462,7 @@ impl Executive {
         let start_instant = start.map_or_else(Instant::now, |s| s.instant);
         let mut t0 = start_instant;
         let mut t0_ns = 0u64;
-        for slot in &mut self.slots {
+        for (index, slot) in self.slots.iter_mut().enumerate() {
             let ctx = CycleContext {
                 cycle,
                 now: t0,
@@ -498,6 +505,13 @@ impl Executive {
                 t0_ns = t1_ns;
                 t0 = start.after(t1_ns);
             }
+            if let Some(c) = self
+                .monitor
+                .as_ref()
+                .and_then(|m| m.controllers().get(index))
+            {
+                c.publish(slot, cycle);
+            }
             if let Some(trace) = &mut self.trace {
                 let bk = slot.ctrl.bookkeeping();
                 let detail = TraceDetail {
@@ -535,6 +549,7 @@ impl Executive {
         }
         self.cycle = cycle.wrapping_add(1);
         self.stats.cycles = self.cycle;
+        self.publish_executive();
         self.shared.cycle.store(self.cycle, Ordering::Release);
         if let Some(signal) = &self.signal {
             signal.raise();
@@ -564,6 +579,8 @@ impl Executive {
 }
 
 mod lookup;
+mod monitor;
+pub use monitor::{ControllerFigures, ControllerMonitor, ExecutiveMonitor};
 
 #[cfg(test)]
 mod tests;

@@ -216,8 +216,8 @@ pub use bridge::{Bridge, BridgeConfig, BridgeError};
 pub use epoch::fresh_epoch;
 pub use error::SetupError;
 pub use exec::{
-    Controller, ControllerStats, CycleContext, Executive, ExecutiveConfig, ExecutiveHandle,
-    ExecutiveStats, Heartbeat, Wait,
+    Controller, ControllerFigures, ControllerMonitor, ControllerStats, CycleContext, Executive,
+    ExecutiveConfig, ExecutiveHandle, ExecutiveMonitor, ExecutiveStats, Heartbeat, Wait,
 };
 pub use fault::{ControllerPanic, CycleFault};
 pub use gm::{

@@ -19,6 +19,7 @@
 //! cargo run -p submarine-example -- --fast       # flat out, at most 2,000 cycles
 //! cargo run -p submarine-example -- --fast 500 --speed 12 --every 1
 //! cargo run -p submarine-example -- --fast --trace run.jsonl   # then: rcsc trace run.jsonl
+//! cargo run -p submarine-example -- --console    # live, under the operator's console (console.rs)
 //! ```
 //!
 //! Exit status: 0 when PR reports `AT_GOAL`, 1 when it does not (cycle limit
@@ -33,6 +34,8 @@ rcs_runtime::include_plans!("submarine");
 
 use submarine::types::{Ship, ShipDirection, SpeedError, TurbineDrive, TurbineSensors};
 use submarine::{pr, sm, tb, Hooks, System};
+
+mod console;
 
 /// The submarine system with PR's hooks.
 type Sub = System<Propulsion>;
@@ -64,6 +67,8 @@ const USAGE: &str = "usage: submarine [--fast [CYCLES]] [--speed KNOTS] [--every
   --speed KNOTS     the speed to order: SM <- TRANSIT(speed: KNOTS) (default 15)
   --every CYCLES    print a table row every CYCLES cycles (default 2)
   --hold CYCLES     after AT_GOAL, keep running CYCLES more cycles to show the speed holds (default 0)
+  --console         run the hierarchy on its executive's thread and the operator's console in the
+                    terminal (docs/console.md): watch it, pause, step, command SM; q quits
   --trace FILE      write every controller's cycles to FILE (JSON lines, or MCAP when FILE
                     ends in .mcap; docs/trace-format.md;
                     `rcsc trace FILE` sums them up); also the RCSC_TRACE environment variable";
@@ -248,6 +253,8 @@ struct Options {
     /// Where to write the executive's trace, if anywhere.
     trace: Option<std::path::PathBuf>,
     fast: bool,
+    /// Run under the operator's console instead of printing a table.
+    console: bool,
     max_cycles: u64,
     speed: f64,
     every: u64,
@@ -259,6 +266,7 @@ impl Options {
         let mut opts = Options {
             trace: std::env::var_os("RCSC_TRACE").map(Into::into),
             fast: false,
+            console: false,
             max_cycles: MAX_CYCLES,
             speed: 15.0,
             every: 2,
@@ -268,6 +276,7 @@ impl Options {
         while let Some(arg) = args.next() {
             match arg.as_str() {
                 "-h" | "--help" => return Ok(None),
+                "--console" => opts.console = true,
                 "--fast" => {
                     opts.fast = true;
                     if let Some(n) = args.peek().and_then(|a| a.parse::<u64>().ok()) {
@@ -320,6 +329,9 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    if opts.console {
+        return console::run();
+    }
     let trace = match &opts.trace {
         None => None,
         Some(path) => match rcs_runtime::TraceSink::create(path) {

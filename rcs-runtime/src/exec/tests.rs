@@ -284,3 +284,55 @@ fn each_controller_sees_when_its_turn_began() -> Result<(), Box<dyn std::error::
     }
     Ok(())
 }
+
+/// Fires row 0 into S1 on its first cycle, then row 1 (S1 -> same) on
+/// every other.
+struct Planner {
+    bk: Bookkeeping,
+}
+impl Controller for Planner {
+    fn name(&self) -> &str {
+        "P"
+    }
+    fn cycle(&mut self, ctx: &CycleContext) {
+        self.bk.begin_cycle_raw(ctx.tick(), 1, 1, 1, true);
+        let row = if self.bk.state() == 0 { 0 } else { 1 };
+        let target = if row == 0 {
+            crate::Target::State(1)
+        } else {
+            crate::Target::Same
+        };
+        self.bk.fire(row, target);
+        self.bk.end_cycle();
+    }
+    fn bookkeeping(&self) -> Option<&Bookkeeping> {
+        Some(&self.bk)
+    }
+}
+
+#[test]
+fn a_monitor_publishes_state_rows_fired_and_hit_counts() -> Result<(), SetupError> {
+    let mut exec = Executive::new(ExecutiveConfig::new("cpu", Duration::from_millis(10)))?;
+    exec.add(Box::new(Planner {
+        bk: Bookkeeping::new(2),
+    }))?;
+    exec.add(Box::new(Counter(0)))?;
+    let monitor = exec.attach_monitor(1);
+    assert_eq!(monitor.controllers().len(), 2);
+    let p = &monitor.controllers()[0];
+    assert_eq!(p.figures().last_fired, None);
+    exec.run_cycles(5)
+        .map_err(|_| SetupError::ZeroPeriod("panic".into()))?;
+    let f = p.figures();
+    assert!(f.has_plans);
+    assert_eq!((f.verb, f.state), (1, 1));
+    assert_eq!(f.status, crate::Status::EXECUTING);
+    assert_eq!(f.last_fired, Some((1, 1, 4)));
+    // Room for one row per verb: row 0 counted, row 1 (4 times) dropped.
+    assert_eq!(p.hits(1, 0), Some(1));
+    assert_eq!(p.hits(1, 1), None);
+    assert_eq!(p.hits_dropped(), 4);
+    assert!(!monitor.controllers()[1].figures().has_plans);
+    assert_eq!(monitor.name(), "cpu");
+    Ok(())
+}

@@ -324,14 +324,17 @@ pub(crate) fn module(
         .all(|v| derivable_default(&v.ty) && v.init.as_ref().is_none_or(is_zero));
     // A type's shared module: `Default` with the first instance's values
     // (for `Data::default`), and each instance's own in `Vars::for_instance`.
-    let first = Names {
-        slots: None,
-        ..names.clone()
-    };
+    // Built only when needed: a `Names` holds every controller's names, so
+    // a copy per controller would make generation quadratic in the set.
+    let first;
     let (vars_derive, mut vars_default) = if var_defaults_derivable {
         (quote!(Default,), quote!())
     } else {
         let gen = if shared.is_some() {
+            first = Names {
+                slots: None,
+                ..names.clone()
+            };
             Gen::new(ir, &first, ci)
         } else {
             const_gen

@@ -101,6 +101,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "/// Every plan set above: its path from the workspace root and its\n\
          /// generated scenario driver.\npub const SETS: &[PlanSet] = &[\n{registry}];\n"
     ));
+    // The console benchmark's fleet (examples/console_load.rs includes it;
+    // not a set of the registry: it has no scenarios to differ on).
+    rcs_codegen::Config::new()
+        .out_dir(out.join("fleet"))
+        .graphs(false)
+        .compile("fleet")?;
     let hierarchies = random_hierarchies(&out, &mut includes)?;
     includes.push_str(&format!(
         "/// Random hierarchies whose checks found a cross-controller finding\n\
@@ -113,6 +119,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // (`Config::compile` names only the sets that were there).
     println!("cargo::rerun-if-changed=../../plans");
     println!("cargo::rerun-if-changed=../../tests/data/ok");
+    println!("cargo::rerun-if-changed=fleet");
     println!("cargo::rerun-if-changed=c/pr_template.c");
     println!("cargo::rerun-if-changed=../../rcs-dsl/tests/common/hierarchy.rs");
     cc::Build::new()

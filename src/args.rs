@@ -53,6 +53,10 @@ pub(crate) enum Command {
     /// Make a development CA and per-process certificates for a distributed plan set.
     #[command(after_help = crate::certs_cmd::CERTS_HELP)]
     Certs(crate::certs_cmd::CertsArgs),
+    /// The language server for editors: JSON-RPC over stdin/stdout
+    /// (diagnostics as you type, hover, definition, references, symbols,
+    /// completion).
+    Lsp,
     /// Watch and act on a running system: the operator's console (in-process today).
     #[cfg(feature = "console")]
     #[command(after_help = crate::console_cmd::CONSOLE_HELP)]

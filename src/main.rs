@@ -15,6 +15,7 @@ mod completions;
 mod console_cmd;
 mod diff_cmd;
 mod doc_cmd;
+mod lsp;
 mod output;
 mod test_cmd;
 mod trace_cmd;
@@ -38,6 +39,7 @@ fn main() -> ExitCode {
         Command::Certs(args) => certs_cmd::certs(args),
         #[cfg(feature = "console")]
         Command::Console(args) => console_cmd::console(args),
+        Command::Lsp => lsp::lsp(),
         Command::Completions(args) => completions::completions(args),
         Command::Man(args) => completions::man(args),
     }

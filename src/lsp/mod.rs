@@ -121,40 +121,38 @@ impl Server {
 
     fn notify(&mut self, n: Notification) -> Vec<Notification> {
         let path = match n.method.as_str() {
-            DidOpenTextDocument::METHOD => {
-                let Ok(p) =
-                    serde_json::from_value::<lsp_types::DidOpenTextDocumentParams>(n.params)
-                else {
-                    return Vec::new();
-                };
-                let path = uri_path(&p.text_document.uri);
-                self.docs.open(path.clone(), p.text_document.text);
-                path
-            }
+            DidOpenTextDocument::METHOD => params::<lsp_types::DidOpenTextDocumentParams>(n.params)
+                .ok()
+                .map(|p| {
+                    let path = uri_path(&p.text_document.uri);
+                    self.docs.open(path.clone(), p.text_document.text);
+                    path
+                }),
             DidChangeTextDocument::METHOD => {
-                let Ok(p) =
-                    serde_json::from_value::<lsp_types::DidChangeTextDocumentParams>(n.params)
-                else {
-                    return Vec::new();
-                };
-                let path = uri_path(&p.text_document.uri);
-                // Full sync: the last change holds the whole text.
-                if let Some(change) = p.content_changes.into_iter().last() {
-                    self.docs.open(path.clone(), change.text);
-                }
-                path
+                params::<lsp_types::DidChangeTextDocumentParams>(n.params)
+                    .ok()
+                    .map(|p| {
+                        let path = uri_path(&p.text_document.uri);
+                        // Full sync: the last change holds the whole text.
+                        if let Some(change) = p.content_changes.into_iter().last() {
+                            self.docs.open(path.clone(), change.text);
+                        }
+                        path
+                    })
             }
             DidCloseTextDocument::METHOD => {
-                let Ok(p) =
-                    serde_json::from_value::<lsp_types::DidCloseTextDocumentParams>(n.params)
-                else {
-                    return Vec::new();
-                };
-                let path = uri_path(&p.text_document.uri);
-                self.docs.close(&path);
-                path
+                params::<lsp_types::DidCloseTextDocumentParams>(n.params)
+                    .ok()
+                    .map(|p| {
+                        let path = uri_path(&p.text_document.uri);
+                        self.docs.close(&path);
+                        path
+                    })
             }
-            _ => return Vec::new(),
+            _ => None,
+        };
+        let Some(path) = path else {
+            return Vec::new();
         };
         self.cache = None;
         if path.extension().is_none_or(|e| e != "rcs" && e != "yaml") {

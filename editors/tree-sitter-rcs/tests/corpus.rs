@@ -410,3 +410,38 @@ fn highlight_queries_compile_and_capture_keywords_comments_and_labels() {
         );
     }
 }
+
+/// Helix names its captures its own way (`@constant.numeric`, not
+/// `@number`); editors/helix holds the same queries under Helix's names.
+/// The table is the one editors/README.md gives as a `sed` command.
+const HELIX_NAMES: [(&str, &str); 6] = [
+    ("@comment.documentation", "@comment.line.documentation"),
+    ("@keyword.conditional", "@keyword.control.conditional"),
+    ("@number", "@constant.numeric"),
+    ("@boolean", "@constant.builtin.boolean"),
+    ("@property", "@variable.other.member"),
+    ("@function.call", "@function"),
+];
+
+#[test]
+fn helix_queries_are_these_queries_under_helix_names() {
+    let path = repo_root().join("editors/helix/queries/rcs/highlights.scm");
+    let helix = std::fs::read_to_string(&path).expect("editors/helix/queries/rcs/highlights.scm");
+    let body: String = helix
+        .lines()
+        .skip_while(|line| line.starts_with("; Generated") || line.starts_with("; "))
+        .skip(1)
+        .map(|line| format!("{line}\n"))
+        .collect();
+    let mut want = tree_sitter_rcs::HIGHLIGHTS_QUERY.to_string();
+    for (from, to) in HELIX_NAMES {
+        want = want.replace(from, to);
+    }
+    assert!(
+        body == want,
+        "{} is out of step with queries/highlights.scm: regenerate it with the \
+         sed command of editors/README.md",
+        path.display()
+    );
+    Query::new(&language(), &helix).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+}

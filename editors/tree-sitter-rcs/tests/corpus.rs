@@ -6,8 +6,9 @@
 //! cases that are syntax errors on purpose drop out, the others stay in.
 //!
 //! Also here: the shape of the tree that the highlight queries and editors
-//! rely on (a row's parts are fields, operators nest by precedence), and
-//! the highlight queries compiled and run against the grammar.
+//! rely on (a row's parts are fields, operators nest by precedence), the
+//! highlight queries compiled and run against the grammar (and Helix's copy
+//! kept in step), and the CLI's `test/corpus` cases, run without the CLI.
 
 use std::path::{Path, PathBuf};
 use tree_sitter::{Language, Node, Parser, Query, QueryCursor, StreamingIterator as _, Tree};
@@ -444,4 +445,77 @@ fn helix_queries_are_these_queries_under_helix_names() {
         path.display()
     );
     Query::new(&language(), &helix).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+}
+
+/// `test/corpus/*.txt`, the cases `tree-sitter test` runs, checked here too
+/// so that CI holds them without the CLI: each case's input must give the
+/// tree written under it (field names aside, as the CLI compares).
+#[test]
+fn the_cli_corpus_cases_give_their_trees() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("test/corpus");
+    let mut files = Vec::new();
+    files_under(&dir, &[".txt"], &mut files);
+    files.sort();
+    assert!(!files.is_empty(), "no corpus files in {}", dir.display());
+    let mut cases = 0;
+    for file in files {
+        let text = std::fs::read_to_string(&file).unwrap();
+        for (title, input, expected) in corpus_cases(&text) {
+            cases += 1;
+            let got = without_field_names(&parse(&input).root_node().to_sexp());
+            assert_eq!(got, squeeze(&expected), "{}: {title}", file.display());
+        }
+    }
+    assert!(cases >= 3, "only {cases} corpus cases");
+}
+
+/// The cases of a corpus file: `===` title `===`, input, `---`, tree.
+fn corpus_cases(text: &str) -> Vec<(String, String, String)> {
+    let is_rule = |line: &str, c: char| line.len() >= 3 && line.chars().all(|x| x == c);
+    let lines: Vec<&str> = text.lines().collect();
+    let mut cases = Vec::new();
+    let mut i = 0;
+    while i + 2 < lines.len() {
+        if !(is_rule(lines[i], '=') && is_rule(lines[i + 2], '=')) {
+            i += 1;
+            continue;
+        }
+        let title = lines[i + 1].to_string();
+        let mut j = i + 3;
+        let mut input = String::new();
+        while j < lines.len() && !is_rule(lines[j], '-') {
+            input.push_str(lines[j]);
+            input.push('\n');
+            j += 1;
+        }
+        let mut expected = String::new();
+        j += 1;
+        while j < lines.len() && !(is_rule(lines[j], '=') && j + 2 < lines.len()) {
+            expected.push_str(lines[j]);
+            expected.push('\n');
+            j += 1;
+        }
+        cases.push((title, input, expected));
+        i = j;
+    }
+    cases
+}
+
+/// An S-expression on one line, single-spaced, no space inside parentheses.
+fn squeeze(sexp: &str) -> String {
+    sexp.split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
+        .replace("( ", "(")
+        .replace(" )", ")")
+}
+
+/// `to_sexp()` without its `field: ` prefixes, squeezed.
+fn without_field_names(sexp: &str) -> String {
+    let words: Vec<&str> = sexp
+        .split_whitespace()
+        // A field name is a word ending in `:` (node kinds start with `(`).
+        .filter(|word| !word.ends_with(':') || word.starts_with('('))
+        .collect();
+    squeeze(&words.join(" "))
 }

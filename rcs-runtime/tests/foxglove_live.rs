@@ -249,6 +249,7 @@ fn a_client_subscribes_to_a_controller_and_sees_its_serials_and_cycles_advance()
     // Command SM twice; each serial must show on SM's channel, with the
     // cycle count rising from message to message.
     let mut last_cycle = None;
+    let mut last_serial = None;
     let mut serials_seen = Vec::new();
     for _ in 0..2 {
         let serial = op.command(GO);
@@ -267,6 +268,14 @@ fn a_client_subscribes_to_a_controller_and_sees_its_serials_and_cycles_advance()
                 assert!(cycle > last, "cycle {cycle} after {last}: {m}");
             }
             last_cycle = Some(cycle);
+            // New exactly when the serial changed since the last message.
+            let serial_now = m["serial"].as_u64();
+            assert_eq!(
+                m["new_command"],
+                last_serial.is_some() && serial_now != last_serial,
+                "{m}"
+            );
+            last_serial = serial_now;
             if m["serial"].as_u64() == Some(u64::from(serial)) {
                 assert_eq!(m["verb"], u64::from(GO));
                 assert_eq!(m["verb_name"], "GO", "{m}");

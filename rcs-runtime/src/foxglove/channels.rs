@@ -396,9 +396,9 @@ impl Channels {
             .map(|r| r.read())
             .filter(|s| s.generation > 0)
             .map(|s| s.value.echo_serial);
-        // Between two samples a new command arrived if the serial changed
-        // (the first message compares with none: a command is new then).
-        let new_command = f.has_plans && serial.is_some() && serial != sent.serial;
+        // A new command arrived between two samples if the serial changed;
+        // the first message to a client has nothing to compare with.
+        let new_command = f.has_plans && sent.serial.is_some() && serial != sent.serial;
         sent.mark = cycles;
         sent.serial = serial;
         let names = self.names.get(ctrl.name());

@@ -100,12 +100,23 @@ fn connect(
         "Sec-WebSocket-Protocol",
         HeaderValue::from_static(subprotocol),
     );
-    tungstenite::client(request, stream).map_err(|e| match e {
-        tungstenite::HandshakeError::Failure(e) => e,
-        tungstenite::HandshakeError::Interrupted(_) => {
-            panic!("the handshake did not finish within the read timeout")
+    // The read timeout interrupts a slow handshake: go on until the
+    // deadline.
+    let start = Instant::now();
+    let mut attempt = tungstenite::client(request, stream);
+    loop {
+        match attempt {
+            Ok(done) => return Ok(done),
+            Err(tungstenite::HandshakeError::Failure(e)) => return Err(e),
+            Err(tungstenite::HandshakeError::Interrupted(mid)) => {
+                assert!(
+                    start.elapsed() < DEADLINE,
+                    "the handshake did not finish within {DEADLINE:?}"
+                );
+                attempt = mid.handshake();
+            }
         }
-    })
+    }
 }
 
 /// The next message, waiting up to [`DEADLINE`].
@@ -425,5 +436,60 @@ fn a_non_loopback_address_is_refused_without_the_opt_in() {
     match FoxgloveServer::start(system, &options) {
         Err(FoxgloveError::NotLoopback(_)) => {}
         other => panic!("expected a refusal, got {other:?}"),
+    }
+}
+
+#[test]
+fn clients_beyond_the_limit_are_turned_away_until_one_leaves() {
+    let (gm, e, monitor, _op) = hierarchy();
+    let (server, handle, join) = serve(&gm, e, monitor);
+    let addr = server.local_addr();
+    let mut clients: Vec<Client> = (0..rcs_runtime::foxglove::MAX_CLIENTS)
+        .map(|_| {
+            let (mut ws, _) = connect(addr, "foxglove.websocket.v1").unwrap();
+            handshake_messages(&mut ws);
+            ws
+        })
+        .collect();
+    assert!(
+        connect(addr, "foxglove.websocket.v1").is_err(),
+        "a client beyond the limit was served"
+    );
+    // One leaves: within the deadline, a new client is served again.
+    let mut leaving = clients.pop().unwrap();
+    leaving.close(None).unwrap();
+    drop(leaving);
+    let start = Instant::now();
+    let mut ws = loop {
+        if let Ok((ws, _)) = connect(addr, "foxglove.websocket.v1") {
+            break ws;
+        }
+        assert!(
+            start.elapsed() < DEADLINE,
+            "no room again after a client left"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    handshake_messages(&mut ws);
+
+    server.stop();
+    handle.stop();
+    join.join().unwrap();
+}
+
+#[test]
+fn a_sampling_rate_out_of_range_is_refused() {
+    let (gm, e, monitor, _op) = hierarchy();
+    for rate_hz in [0, rcs_runtime::foxglove::MAX_RATE_HZ + 1] {
+        let system = LiveSystem::new("x").executive(e.handle(), Arc::clone(&monitor), &gm);
+        let options = FoxgloveOptions {
+            addr: "127.0.0.1:0".parse().unwrap(),
+            rate_hz,
+            ..FoxgloveOptions::default()
+        };
+        assert!(matches!(
+            FoxgloveServer::start(system, &options),
+            Err(FoxgloveError::BadRate(r)) if r == rate_hz
+        ));
     }
 }

@@ -96,7 +96,19 @@ fn foxglove_shows_the_submarine_live() {
         "Sec-WebSocket-Protocol",
         HeaderValue::from_static("foxglove.websocket.v1"),
     );
-    let (mut ws, _) = tungstenite::client(request, stream).expect("the handshake");
+    // The read timeout interrupts a slow handshake: go on until the deadline.
+    let start = Instant::now();
+    let mut attempt = tungstenite::client(request, stream);
+    let mut ws = loop {
+        match attempt {
+            Ok((ws, _)) => break ws,
+            Err(tungstenite::HandshakeError::Failure(e)) => panic!("the handshake failed: {e}"),
+            Err(tungstenite::HandshakeError::Interrupted(mid)) => {
+                assert!(start.elapsed() < DEADLINE, "the handshake did not finish");
+                attempt = mid.handshake();
+            }
+        }
+    };
 
     let info = next_json(&mut ws);
     assert_eq!(info["op"], "serverInfo");

@@ -2,6 +2,10 @@
 //! `$OUT_DIR/rcs/rust/submarine.rs`, as a user's build.rs would.
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    rcs_codegen::Config::new().compile("../../plans/submarine")?;
+    // serde derives on the buffer types: `--foxglove` serves the `ship`,
+    // `turbine` and `drive` buffers live as JSON (src/foxglove.rs).
+    rcs_codegen::Config::new()
+        .serde(rcs_codegen::SerdeDerives::Always)
+        .compile("../../plans/submarine")?;
     Ok(())
 }

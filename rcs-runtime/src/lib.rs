@@ -194,6 +194,8 @@ pub mod epoch;
 pub mod error;
 pub mod exec;
 pub mod fault;
+#[cfg(feature = "foxglove")]
+pub mod foxglove;
 pub mod gm;
 pub mod handshake;
 pub mod heartbeat;

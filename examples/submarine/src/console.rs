@@ -21,7 +21,7 @@ use crate::{Plant, Propulsion, DEAD_BAND_KN, MODEL_RPM_PER_KNOT};
 
 /// The plan set the program was generated from (build.rs), for the
 /// console's names and plan tables.
-const PLANS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../plans/submarine");
+pub const PLANS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../plans/submarine");
 
 /// The ship and turbine as a controller: steps the plant under TB's drive
 /// output at the end of each cycle and writes what the sensors read next.
@@ -47,8 +47,8 @@ impl Controller for Simulator {
 
 /// Run the submarine on its executives' threads and the console in the
 /// foreground until the operator quits.
-pub fn run() -> ExitCode {
-    match try_run() {
+pub fn run(foxglove: Option<&crate::foxglove::FoxgloveArgs>) -> ExitCode {
+    match try_run(foxglove) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("submarine: {e}");
@@ -57,7 +57,7 @@ pub fn run() -> ExitCode {
     }
 }
 
-fn try_run() -> Result<(), String> {
+fn try_run(foxglove: Option<&crate::foxglove::FoxgloveArgs>) -> Result<(), String> {
     let catalog = Catalog::load(Path::new(PLANS))?;
     let hooks = Propulsion {
         rpm_per_knot: MODEL_RPM_PER_KNOT,
@@ -99,6 +99,16 @@ fn try_run() -> Result<(), String> {
                 .map_err(|e| format!("cannot start an executive: {e}"))?,
         );
     }
+    let live: Vec<_> = running
+        .iter()
+        .map(|(h, _)| h.clone())
+        .zip(monitors.iter().cloned())
+        .collect();
+    // Served while the console runs (dropped when it returns).
+    let _live = match foxglove {
+        Some(args) => Some(crate::foxglove::start(args, &catalog, &gm, &live)?),
+        None => None,
+    };
     let mut sm_operator = operators.sm;
     let commander = Box::new(move |root: &str, verb: &str, args: &[ArgValue]| {
         let command = match (root, verb, args) {

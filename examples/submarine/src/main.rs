@@ -20,6 +20,7 @@
 //! cargo run -p submarine-example -- --fast 500 --speed 12 --every 1
 //! cargo run -p submarine-example -- --fast --trace run.jsonl   # then: rcsc trace run.jsonl
 //! cargo run -p submarine-example -- --console    # live, under the operator's console (console.rs)
+//! cargo run -p submarine-example -- --console --foxglove   # …and in Foxglove / Lichtblick (foxglove.rs)
 //! ```
 //!
 //! Exit status: 0 when PR reports `AT_GOAL`, 1 when it does not (cycle limit
@@ -36,6 +37,7 @@ use submarine::types::{Ship, ShipDirection, SpeedError, TurbineDrive, TurbineSen
 use submarine::{pr, sm, tb, Hooks, System};
 
 mod console;
+mod foxglove;
 
 /// The submarine system with PR's hooks.
 type Sub = System<Propulsion>;
@@ -69,6 +71,11 @@ const USAGE: &str = "usage: submarine [--fast [CYCLES]] [--speed KNOTS] [--every
   --hold CYCLES     after AT_GOAL, keep running CYCLES more cycles to show the speed holds (default 0)
   --console         run the hierarchy on its executive's thread and the operator's console in the
                     terminal (docs/console.md): watch it, pause, step, command SM; q quits
+  --foxglove [ADDR] serve the hierarchy live to Foxglove / Lichtblick over the Foxglove WebSocket
+                    protocol at ws://ADDR (default 127.0.0.1:8765; read-only; docs/console.md)
+  --foxglove-allow-remote
+                    let --foxglove listen on an address beyond loopback (the protocol has no
+                    authentication: anyone who reaches the port sees the system)
   --trace FILE      write every controller's cycles to FILE (JSON lines, or MCAP when FILE
                     ends in .mcap; docs/trace-format.md;
                     `rcsc trace FILE` sums them up); also the RCSC_TRACE environment variable";
@@ -255,6 +262,10 @@ struct Options {
     fast: bool,
     /// Run under the operator's console instead of printing a table.
     console: bool,
+    /// Serve the hierarchy live to Foxglove / Lichtblick.
+    foxglove: Option<foxglove::FoxgloveArgs>,
+    /// `--foxglove-allow-remote`.
+    foxglove_allow_remote: bool,
     max_cycles: u64,
     speed: f64,
     every: u64,
@@ -267,6 +278,8 @@ impl Options {
             trace: std::env::var_os("RCSC_TRACE").map(Into::into),
             fast: false,
             console: false,
+            foxglove: None,
+            foxglove_allow_remote: false,
             max_cycles: MAX_CYCLES,
             speed: 15.0,
             every: 2,
@@ -277,6 +290,12 @@ impl Options {
             match arg.as_str() {
                 "-h" | "--help" => return Ok(None),
                 "--console" => opts.console = true,
+                "--foxglove" => {
+                    // An address follows unless the next word is an option.
+                    let addr = args.next_if(|a| !a.starts_with('-'));
+                    opts.foxglove = Some(foxglove::FoxgloveArgs::parse(addr.as_deref())?);
+                }
+                "--foxglove-allow-remote" => opts.foxglove_allow_remote = true,
                 "--fast" => {
                     opts.fast = true;
                     if let Some(n) = args.peek().and_then(|a| a.parse::<u64>().ok()) {
@@ -313,6 +332,11 @@ impl Options {
                 other => return Err(format!("unexpected argument `{other}`")),
             }
         }
+        if let Some(f) = &mut opts.foxglove {
+            f.allow_remote = opts.foxglove_allow_remote;
+        } else if opts.foxglove_allow_remote {
+            return Err("--foxglove-allow-remote goes with --foxglove".to_string());
+        }
         Ok(Some(opts))
     }
 }
@@ -330,7 +354,7 @@ fn main() -> ExitCode {
         }
     };
     if opts.console {
-        return console::run();
+        return console::run(opts.foxglove.as_ref());
     }
     let trace = match &opts.trace {
         None => None,
@@ -355,15 +379,12 @@ fn main() -> ExitCode {
 /// Run until PR reports AT_GOAL (`Ok(true)`), a controller fails or the cycle
 /// limit passes (`Ok(false)`).
 /// With `trace`, the executive writes every controller's cycles to it.
-fn run(
-    opts: Options,
-    trace: Option<rcs_runtime::TraceSink>,
-) -> Result<bool, rcs_runtime::SetupError> {
+fn run(opts: Options, trace: Option<rcs_runtime::TraceSink>) -> Result<bool, String> {
     let hooks = Propulsion {
         rpm_per_knot: MODEL_RPM_PER_KNOT,
         dead_band: DEAD_BAND_KN,
     };
-    let mut system = System::new(Hooks { pr: hooks })?;
+    let mut system = System::new(Hooks { pr: hooks }).map_err(|e| e.to_string())?;
     let Some(period) = system.executives.first().map(Executive::period) else {
         return Ok(false);
     };
@@ -371,6 +392,20 @@ fn run(
     if let (Some(sink), Some(exec)) = (trace, system.executives.first_mut()) {
         exec.set_trace(sink);
     }
+    // Served live while this function runs the cycles (dropped at its end).
+    let _live = match &opts.foxglove {
+        Some(args) => {
+            let catalog = rcs_console::Catalog::load(std::path::Path::new(console::PLANS))?;
+            let rows = catalog.max_rows();
+            let running: Vec<_> = system
+                .executives
+                .iter_mut()
+                .map(|e| (e.handle(), e.attach_monitor(rows)))
+                .collect();
+            Some(foxglove::start(args, &catalog, &system.gm, &running)?)
+        }
+        None => None,
+    };
 
     // The world before the first cycle: a stopped ship, a still turbine.
     let mut plant = Plant::default();
@@ -396,7 +431,7 @@ fn run(
     // Real time: the executive's heartbeat (absolute deadlines, sleep then
     // spin), stepped here so that the simulators and the display run between
     // cycles on this thread.
-    let mut heartbeat = Heartbeat::new(period, Wait::default())?;
+    let mut heartbeat = Heartbeat::new(period, Wait::default()).map_err(|e| e.to_string())?;
     let mut lateness = SampleStats::default();
     let mut missed = 0u64;
     let started = Instant::now();

@@ -20,7 +20,8 @@ use std::io::{self, Seek, Write};
 use serde::Serialize;
 
 use super::jsonl::check_header;
-use super::{TraceDetail, TraceHeader, TraceRecord, TRACE_FORMAT};
+use super::{buffer_topic, controller_topic, TraceDetail, TraceHeader, TraceRecord, TRACE_FORMAT};
+pub use super::{CONTROLLER_SCHEMA, CONTROLLER_SCHEMA_NAME};
 
 /// A writer an MCAP sink can own: MCAP seeks back to finish its chunks.
 pub trait SeekWrite: Write + Seek + Send {}
@@ -28,38 +29,9 @@ impl<T: Write + Seek + Send> SeekWrite for T {}
 
 /// The name of the metadata record that says a recording is an rcs trace.
 pub const METADATA_NAME: &str = "rcs-trace";
-/// The schema name of the controller channels.
-pub const CONTROLLER_SCHEMA_NAME: &str = "rcs.ControllerCycle";
 /// Channel metadata key naming what a channel carries (`controller` or
 /// `buffer`).
 pub const KIND_KEY: &str = "rcs.kind";
-
-/// The JSON Schema of a controller channel's messages.
-pub const CONTROLLER_SCHEMA: &str = r#"{
-  "$schema": "https://json-schema.org/draft/2020-12/schema",
-  "title": "rcs.ControllerCycle",
-  "description": "One cycle of one RCS controller (docs/trace-format.md)",
-  "type": "object",
-  "properties": {
-    "executive": { "type": "string", "description": "the executive (CPU) that ran the cycle" },
-    "cycle": { "type": "integer", "description": "the executive's cycle count, from 0" },
-    "time_ns": { "type": "integer", "description": "the message's log time, in nanoseconds" },
-    "controller": { "type": "string", "description": "the controller's name" },
-    "verb": { "type": ["integer", "null"], "description": "the command's verb id" },
-    "verb_name": { "type": "string", "description": "the command's verb" },
-    "state": { "type": ["integer", "null"], "description": "the plan's state id after the cycle" },
-    "state_name": { "type": "string", "description": "the plan's state after the cycle" },
-    "status": { "type": ["integer", "null"], "description": "the status code after the cycle" },
-    "status_name": { "type": "string", "description": "the status after the cycle" },
-    "error": { "type": ["integer", "null"], "description": "the error code after the cycle (0: none)" },
-    "fired": { "type": ["integer", "null"], "description": "the position of the row that fired" },
-    "fired_name": { "type": "string", "description": "the row that fired (E3)" },
-    "new_command": { "type": "boolean", "description": "whether a new command arrived" },
-    "serial": { "type": "integer", "description": "the serial of the command the status is about" },
-    "cycle_ns": { "type": "integer", "description": "how long the controller's cycle took" }
-  },
-  "required": ["executive", "cycle", "time_ns", "controller", "verb", "state", "status", "error", "fired", "new_command"]
-}"#;
 
 /// One Global Memory buffer's value after a cycle, for its channel.
 #[derive(Debug, Clone, Copy)]
@@ -130,20 +102,6 @@ fn finished() -> io::Error {
     io::Error::other("the MCAP recording is already finished")
 }
 
-/// A topic part from a name: characters other than letters, digits, `_`,
-/// `-` and `.` become `_` (`scenario go` → `scenario_go`).
-fn topic_part(name: &str) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.') {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
-}
-
 /// Nanoseconds since the Unix epoch, now (a record written without a time).
 fn now_ns() -> u64 {
     std::time::SystemTime::now()
@@ -212,14 +170,14 @@ impl McapTrace {
         let (schema, topic, kind) = match buffer {
             None => (
                 self.controller_schema,
-                format!("/rcs/{}/{}", topic_part(executive), topic_part(name)),
+                controller_topic(executive, name),
                 "controller",
             ),
             Some((schema_name, schema)) => (
                 writer
                     .add_schema(schema_name, "jsonschema", schema.as_bytes())
                     .map_err(io_error)?,
-                format!("/rcs/{}/gm/{}", topic_part(executive), topic_part(name)),
+                buffer_topic(executive, name),
                 "buffer",
             ),
         };

@@ -92,6 +92,70 @@ pub struct TraceDetail<'a> {
     pub cycle_ns: Option<u64>,
 }
 
+/// The schema name of the controller channels.
+pub const CONTROLLER_SCHEMA_NAME: &str = "rcs.ControllerCycle";
+
+/// The JSON Schema of a controller channel's messages, in an MCAP
+/// recording and live (feature `foxglove`; the fields marked "live only"
+/// come from the executive's monitor, which a recording does not read).
+pub const CONTROLLER_SCHEMA: &str = r#"{
+  "$schema": "https://json-schema.org/draft/2020-12/schema",
+  "title": "rcs.ControllerCycle",
+  "description": "One cycle of one RCS controller (docs/trace-format.md)",
+  "type": "object",
+  "properties": {
+    "executive": { "type": "string", "description": "the executive (CPU) that ran the cycle" },
+    "cycle": { "type": "integer", "description": "the executive's cycle count, from 0" },
+    "time_ns": { "type": "integer", "description": "the message's log time, in nanoseconds" },
+    "controller": { "type": "string", "description": "the controller's name" },
+    "verb": { "type": ["integer", "null"], "description": "the command's verb id" },
+    "verb_name": { "type": "string", "description": "the command's verb" },
+    "state": { "type": ["integer", "null"], "description": "the plan's state id after the cycle" },
+    "state_name": { "type": "string", "description": "the plan's state after the cycle" },
+    "status": { "type": ["integer", "null"], "description": "the status code after the cycle" },
+    "status_name": { "type": "string", "description": "the status after the cycle" },
+    "error": { "type": ["integer", "null"], "description": "the error code after the cycle (0: none)" },
+    "fired": { "type": ["integer", "null"], "description": "the position of the row that fired" },
+    "fired_name": { "type": "string", "description": "the row that fired (E3)" },
+    "new_command": { "type": "boolean", "description": "whether a new command arrived" },
+    "serial": { "type": "integer", "description": "the serial of the command the status is about" },
+    "cycle_ns": { "type": "integer", "description": "how long the controller's cycle took" },
+    "last_fired": { "type": "integer", "description": "live only: the position of the row that fired last, in any cycle" },
+    "last_fired_name": { "type": "string", "description": "live only: the row that fired last" },
+    "last_fired_cycle": { "type": "integer", "description": "live only: the executive's cycle in which it fired" },
+    "exec_max_ns": { "type": "integer", "description": "live only: the controller's longest cycle so far" },
+    "overruns": { "type": "integer", "description": "live only: its cycles that alone took longer than the period" },
+    "panics": { "type": "integer", "description": "live only: panics caught in its cycle" }
+  },
+  "required": ["executive", "cycle", "time_ns", "controller", "verb", "state", "status", "error", "fired", "new_command"]
+}"#;
+
+/// A topic part from a name: characters other than letters, digits, `_`,
+/// `-` and `.` become `_` (`scenario go` → `scenario_go`).
+pub(crate) fn topic_part(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// The topic of controller `controller` of executive `executive`, in a
+/// recording and live: `/rcs/<executive>/<controller>`.
+pub fn controller_topic(executive: &str, controller: &str) -> String {
+    format!("/rcs/{}/{}", topic_part(executive), topic_part(controller))
+}
+
+/// The topic of Global Memory buffer `buffer` written on executive
+/// `executive`, in a recording and live: `/rcs/<executive>/gm/<buffer>`.
+pub fn buffer_topic(executive: &str, buffer: &str) -> String {
+    format!("/rcs/{}/gm/{}", topic_part(executive), topic_part(buffer))
+}
+
 /// The trace format this runtime writes (the header's `version`).
 pub const TRACE_VERSION: u32 = 1;
 

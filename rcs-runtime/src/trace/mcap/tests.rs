@@ -2,7 +2,7 @@
 //! byte-identical for the same input, and damaged recordings refused in
 //! words, never with a panic.
 
-use super::super::{read_trace, read_trace_bytes, TraceReadError, TraceSink};
+use super::super::{read_trace, read_trace_bytes, topic_part, TraceReadError, TraceSink};
 use super::*;
 use std::io::Cursor;
 use std::sync::{Arc, Mutex};

@@ -212,6 +212,17 @@ impl ExecutiveHandle {
         self.shared.paused.store(true, Ordering::SeqCst);
         self.shared.steps.fetch_add(1, Ordering::SeqCst);
     }
+    /// Pause, and run exactly `n` more cycles, one per heartbeat (run N;
+    /// `step_by(1)` is [`step`](Self::step)).
+    pub fn step_by(&self, n: u64) {
+        self.shared.paused.store(true, Ordering::SeqCst);
+        let _ = self
+            .shared
+            .steps
+            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |s| {
+                Some(s.saturating_add(n))
+            });
+    }
     /// Run freely again.
     pub fn go(&self) {
         self.shared.steps.store(0, Ordering::SeqCst);
@@ -384,6 +395,31 @@ impl Executive {
         self.take_fault()
     }
 
+    /// Run one cycle now unless an operator paused this executive through
+    /// its [`ExecutiveHandle`] (a pending single step runs it, and is used
+    /// up): for programs that drive their executives from a heartbeat loop
+    /// of their own rather than [`run`](Self::run), so that pause / step /
+    /// go work for them too. `Ok(false)`: paused, no cycle ran.
+    pub fn step_unless_paused(&mut self) -> Result<bool, CycleFault> {
+        if !self.may_run() {
+            return Ok(false);
+        }
+        self.run_one();
+        self.take_fault().map(|()| true)
+    }
+
+    /// Whether the next heartbeat runs a cycle: not paused, or paused with
+    /// a single step pending (which this call uses up).
+    fn may_run(&self) -> bool {
+        let paused = self.shared.paused.load(Ordering::Acquire);
+        !paused
+            || self
+                .shared
+                .steps
+                .fetch_update(Ordering::AcqRel, Ordering::Acquire, |s| s.checked_sub(1))
+                .is_ok()
+    }
+
     fn take_fault(&mut self) -> Result<(), CycleFault> {
         match self.fault.take() {
             None => Ok(()),
@@ -416,14 +452,7 @@ impl Executive {
                 break;
             }
             beats += 1;
-            let paused = self.shared.paused.load(Ordering::Acquire);
-            let stepping = paused
-                && self
-                    .shared
-                    .steps
-                    .fetch_update(Ordering::AcqRel, Ordering::Acquire, |s| s.checked_sub(1))
-                    .is_ok();
-            if !paused || stepping {
+            if self.may_run() {
                 self.run_one();
                 // On the heartbeat, panics live on in the statistics
                 // (`panics`, `last_panic`) rather than piling up here.

@@ -45,6 +45,10 @@ const USAGE: &str = "usage: submarine-split helm|engine|one-process (--certs DIR
 /// (`plans/propulsion.rcs`).
 const WATCHDOG_BOUND: u32 = 30;
 
+/// Hit counters per verb for a remote console: more than the longest plan
+/// of `plans/` (rows beyond would be counted as dropped, not shown).
+const CONSOLE_ROWS: usize = 16;
+
 /// The helm's port, which the engine connects to.
 const DEFAULT_PORT: &str = "127.0.0.1:7447";
 
@@ -318,8 +322,11 @@ fn report_bridge_errors(bridge: &rcs_runtime::Bridge, shown: &mut u64) {
 /// SM and PR: wait for TB, order TRANSIT, print status changes; orders from
 /// standard input. Returns whether PR reached AT_GOAL at least once.
 fn helm(opts: &Options) -> Result<bool, String> {
-    let (mut system, bridge) =
+    let (mut system, mut bridge) =
         Sub::process("helm", opts.bridge(), Hooks { pr: PROPULSION }).map_err(|e| e.to_string())?;
+    bridge
+        .serve_console(&system.gm, &mut system.executives, CONSOLE_ROWS)
+        .map_err(|e| e.to_string())?;
     let tb_status = system
         .gm
         .reader::<StatusBuffer>(&rcs_runtime::status_buffer_name(tb::NAME))
@@ -380,7 +387,7 @@ fn helm(opts: &Options) -> Result<bool, String> {
             order(&mut system, speed);
             goal_seen = false;
         }
-        if let Err(fault) = system.run_cycles(1) {
+        if let Err(fault) = cycle_unless_paused(&mut system) {
             // Contained: the faulty controller's plan ended with HOOK_PANIC.
             eprintln!("submarine-split: {fault}");
         }
@@ -426,7 +433,10 @@ fn helm(opts: &Options) -> Result<bool, String> {
 
 /// TB with the simulated turbine and ship, on its own heartbeat.
 fn engine(opts: &Options) -> Result<bool, String> {
-    let (mut system, bridge) = Sub::process("engine", opts.bridge(), Hooks { pr: PROPULSION })
+    let (mut system, mut bridge) = Sub::process("engine", opts.bridge(), Hooks { pr: PROPULSION })
+        .map_err(|e| e.to_string())?;
+    bridge
+        .serve_console(&system.gm, &mut system.executives, CONSOLE_ROWS)
         .map_err(|e| e.to_string())?;
     let period = system
         .executives
@@ -458,7 +468,7 @@ fn engine(opts: &Options) -> Result<bool, String> {
     let mut cycle = 0u64;
     while opts.cycles.is_none_or(|n| cycle < n) {
         heartbeat.wait();
-        if let Err(fault) = system.run_cycles(1) {
+        if let Err(fault) = cycle_unless_paused(&mut system) {
             // Contained: the faulty controller's plan ended with HOOK_PANIC.
             eprintln!("submarine-split: {fault}");
         }
@@ -491,6 +501,22 @@ fn engine(opts: &Options) -> Result<bool, String> {
         cycle += 1;
     }
     Ok(true)
+}
+
+/// One cycle of each executive of this process, unless a console paused
+/// it (a single step it asked for runs): `System::run_cycles(1)` for a
+/// main loop that a remote console may pause.
+fn cycle_unless_paused(system: &mut Sub) -> Result<(), rcs_runtime::CycleFault> {
+    let mut fault: Option<rcs_runtime::CycleFault> = None;
+    for exec in &mut system.executives {
+        if let Err(f) = exec.step_unless_paused() {
+            match &mut fault {
+                Some(first) => first.merge(f),
+                None => fault = Some(f),
+            }
+        }
+    }
+    fault.map_or(Ok(()), Err)
 }
 
 /// The same hierarchy and simulators in one process, flat out: prints the

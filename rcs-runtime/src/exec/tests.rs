@@ -336,3 +336,21 @@ fn a_monitor_publishes_state_rows_fired_and_hit_counts() -> Result<(), SetupErro
     assert_eq!(monitor.name(), "cpu");
     Ok(())
 }
+
+#[test]
+fn a_main_loop_honours_pause_step_and_go() {
+    let mut e = Executive::new(ExecutiveConfig::new("loop", Duration::from_millis(10))).unwrap();
+    let h = e.handle();
+    assert_eq!(e.step_unless_paused(), Ok(true));
+    h.pause();
+    assert_eq!(e.step_unless_paused(), Ok(false));
+    assert_eq!(e.cycle(), 1);
+    h.step_by(2);
+    assert_eq!(e.step_unless_paused(), Ok(true));
+    assert_eq!(e.step_unless_paused(), Ok(true));
+    assert_eq!(e.step_unless_paused(), Ok(false));
+    assert_eq!((e.cycle(), h.cycle(), h.pending_steps()), (3, 3, 0));
+    h.go();
+    assert_eq!(e.step_unless_paused(), Ok(true));
+    assert_eq!(e.cycle(), 4);
+}

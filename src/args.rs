@@ -53,7 +53,7 @@ pub(crate) enum Command {
     /// Make a development CA and per-process certificates for a distributed plan set.
     #[command(after_help = crate::certs_cmd::CERTS_HELP)]
     Certs(crate::certs_cmd::CertsArgs),
-    /// Watch and act on a running system: the operator's console (in-process today).
+    /// Watch and act on a running system: the operator's console (over Zenoh with --connect).
     #[cfg(feature = "console")]
     #[command(after_help = crate::console_cmd::CONSOLE_HELP)]
     Console(crate::console_cmd::ConsoleArgs),

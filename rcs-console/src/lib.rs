@@ -18,6 +18,8 @@
 //! - [`catalog`]: the plan set's names, parameter types and plan tables;
 //! - [`model`]: plain-data snapshots and the model the view draws;
 //! - [`source`]: the [`Source`] trait and the in-process attachment;
+//! - `remote` (feature `zenoh`): the console as a process of its own,
+//!   attached over the Zenoh transport of a distributed plan set;
 //! - [`app`]: keys and prompts; [`view`]: drawing; `term`: the terminal.
 //!
 //! The console never blocks or slows a control cycle: it reads atomics and
@@ -26,6 +28,8 @@
 pub mod app;
 pub mod catalog;
 pub mod model;
+#[cfg(feature = "zenoh")]
+pub mod remote;
 pub mod source;
 mod term;
 pub mod view;

@@ -32,6 +32,9 @@ pub struct CpuSnapshot {
     pub lateness_last_ns: u64,
     /// The latest a heartbeat woke, ns.
     pub lateness_max_ns: u64,
+    /// How long its process has not been heard from, ms, once that is
+    /// long enough to be news (a remote source; `None` in-process).
+    pub silent_ms: Option<u64>,
 }
 
 /// One controller at one moment.

@@ -23,7 +23,7 @@ use submarine_split::{pr, sm, tb, Hooks, System};
 /// The split submarine with PR's hooks.
 type Sub = System<Propulsion>;
 
-const USAGE: &str = "usage: submarine-split helm|engine|one-process (--certs DIR | --insecure) [--listen ENDPOINT] [--connect ENDPOINT] [--speed KNOTS] [--cycles N] [--report-every N] [--report-generations]
+const USAGE: &str = "usage: submarine-split helm|engine|one-process (--certs DIR | --insecure) [--listen ENDPOINT] [--connect ENDPOINT] [--speed KNOTS] [--cycles N] [--report-every N] [--report-generations] [--no-order]
 
   helm         SM and PR; listens on tls/127.0.0.1:7447; orders SM <- TRANSIT(speed) once TB answers;
                `transit KNOTS` on standard input orders again
@@ -34,6 +34,8 @@ const USAGE: &str = "usage: submarine-split helm|engine|one-process (--certs DIR
                and the access-control policy rcsc generated for the process
   --insecure   no TLS, no access control (tcp/ endpoints): anyone on the network can command the ship
   --cycles N   stop after N cycles (default: run until killed; one-process: 2000)
+  --no-order   the helm orders nothing itself: orders come from standard input or an operator
+               (a console: `rcsc console PLANS --connect …`)
   --report-every N  also print a `report` line every N cycles: the helm the ship's speed and age,
                the engine the turbine's drive, both the bridge's refused samples
   --report-generations
@@ -141,6 +143,9 @@ struct Options {
     insecure: bool,
     report_every: Option<u64>,
     report_generations: bool,
+    /// The helm waits for orders (stdin, or a remote operator) instead of
+    /// ordering TRANSIT(speed) itself.
+    no_order: bool,
 }
 
 impl Options {
@@ -161,11 +166,13 @@ impl Options {
             insecure: false,
             report_every: None,
             report_generations: false,
+            no_order: false,
         };
         while let Some(arg) = args.next() {
             let mut value = || args.next().ok_or(format!("{arg} needs a value"));
             match arg.as_str() {
                 "--report-generations" => opts.report_generations = true,
+                "--no-order" => opts.no_order = true,
                 "--listen" => opts.listen = Some(value()?),
                 "--certs" => opts.certs = Some(value()?.into()),
                 "--insecure" => opts.insecure = true,
@@ -369,7 +376,9 @@ fn helm(opts: &Options) -> Result<bool, String> {
         system.operators.sm.command(sm::Command::Transit { speed });
         println!("order SM <- TRANSIT(speed: {speed:.2})");
     };
-    order(&mut system, opts.speed);
+    if !opts.no_order {
+        order(&mut system, opts.speed);
+    }
     let period = system
         .executives
         .first()

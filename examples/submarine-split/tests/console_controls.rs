@@ -7,6 +7,9 @@
 //! control (`--insecure`) the same outsider pauses the helm, which is what
 //! makes the refusals above able to fail.
 //!
+//! The console's command encoding (it has no generated types) is compared
+//! byte for byte with the typed encoding of the generated `sm::Command`.
+//!
 //! Every wait has a generous deadline; nothing asserts on timing.
 
 #![cfg(feature = "zenoh")]
@@ -252,4 +255,54 @@ fn without_access_control_an_outsider_pauses_the_helm() {
     until("the helm paused", || {
         naked.executive("helm", "helm").filter(|e| e.paused)
     });
+}
+
+#[allow(dead_code)]
+mod plans {
+    rcs_runtime::include_plans!("submarine_split");
+}
+
+#[test]
+fn the_console_encodes_a_root_command_as_the_generated_type_does() {
+    use plans::submarine_split::sm;
+    use rcs_console::remote::encode::{encode_root_command, Stamps};
+    use rcs_console::{ArgValue, Catalog};
+    use rcs_runtime::CommandBuffer;
+
+    let plans = Path::new(env!("CARGO_MANIFEST_DIR")).join("plans");
+    let catalog = Catalog::load(&plans).expect("the split plan set");
+    let schema = <CommandBuffer<sm::Command> as Schema>::SCHEMA;
+    let stamps = Stamps {
+        instance: 77,
+        generation: 3,
+        serial: 300,
+        epoch: 0xdead_beef,
+    };
+    let typed = |command: sm::Command| {
+        encode_sample(
+            schema,
+            "operator",
+            stamps.instance,
+            stamps.generation,
+            stamps.generation,
+            &CommandBuffer {
+                serial: stamps.serial,
+                epoch: stamps.epoch,
+                command,
+            },
+        )
+        .expect("typed")
+    };
+    let console = |verb: &str, args: &[ArgValue]| {
+        encode_root_command(&catalog, schema, "SM", verb, args, stamps).expect("console")
+    };
+    assert_eq!(
+        console("TRANSIT", &[ArgValue::Float(8.25)]),
+        typed(sm::Command::Transit { speed: 8.25 })
+    );
+    assert_eq!(console("INIT", &[]), typed(sm::Command::Init));
+    assert_ne!(
+        console("TRANSIT", &[ArgValue::Float(8.0)]),
+        typed(sm::Command::Transit { speed: 8.25 })
+    );
 }

@@ -34,7 +34,7 @@ watch, pause / step / resume executives and command the roots, nothing else.
 Examples:
   rcsc console plans/submarine
   rcsc console examples/submarine-split/plans --connect tls/127.0.0.1:7447 \\
-      --connect tls/127.0.0.1:7448 --certs /tmp/sub";
+      --connect tls/127.0.0.1:7448 --certs /tmp/sub --trace session.mcap";
 
 #[derive(clap::Args)]
 pub(crate) struct ConsoleArgs {
@@ -52,6 +52,11 @@ pub(crate) struct ConsoleArgs {
     /// processes run with `--insecure`.
     #[arg(long)]
     pub(crate) insecure: bool,
+    /// Record the session to FILE (with --connect): MCAP when it ends in
+    /// `.mcap`, else JSON lines; one message per controller whose figures
+    /// changed, about ten times a second.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) trace: Option<PathBuf>,
 }
 
 pub(crate) fn console(args: ConsoleArgs) -> ExitCode {
@@ -62,8 +67,8 @@ pub(crate) fn console(args: ConsoleArgs) -> ExitCode {
     if !args.connect.is_empty() {
         return remote(&args, catalog);
     }
-    if args.certs.is_some() || args.insecure {
-        return fail("--certs and --insecure go with --connect ENDPOINT");
+    if args.certs.is_some() || args.insecure || args.trace.is_some() {
+        return fail("--certs, --insecure and --trace go with --connect ENDPOINT");
     }
     print!("{}", summary(&catalog));
     eprintln!(
@@ -109,9 +114,34 @@ fn remote(args: &ConsoleArgs, catalog: Catalog) -> ExitCode {
         Ok(s) => s,
         Err(e) => return fail(format!("cannot attach: {e}")),
     };
-    match rcs_console::run(catalog, &mut source) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => fail(format!("terminal: {e}")),
+    let Some(path) = &args.trace else {
+        return match rcs_console::run(catalog, &mut source) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => fail(format!("terminal: {e}")),
+        };
+    };
+    let sink = match rcs_runtime::TraceSink::create(path) {
+        Ok(s) => s,
+        Err(e) => return fail(format!("cannot write {}: {e}", path.display())),
+    };
+    let mut recording = rcs_console::Recording::new(&mut source, sink, catalog.clone());
+    let ran = rcs_console::run(catalog, &mut recording);
+    let finished = recording.finish();
+    match (ran, finished) {
+        (Err(e), _) => fail(format!("terminal: {e}")),
+        (Ok(()), Err(e)) => fail(format!("cannot finish {}: {e}", path.display())),
+        (Ok(()), Ok((records, lost))) => {
+            eprintln!(
+                "recorded {records} message(s) to {}{}",
+                path.display(),
+                if lost > 0 {
+                    format!(" ({lost} lost to write errors)")
+                } else {
+                    String::new()
+                }
+            );
+            ExitCode::SUCCESS
+        }
     }
 }
 

@@ -8,7 +8,9 @@
 //! paused helm's cycle count by exactly one; a command typed through `c`
 //! reaches SM (the helm says so) and PR reaches AT_GOAL; killing the
 //! engine shows its CPU silent, TB stale and PR's watchdog error
-//! (TURBINE_SILENT); `q` restores the terminal with exit status 0.
+//! (TURBINE_SILENT); `q` restores the terminal with exit status 0, and the
+//! session's recording (`--trace FILE.mcap`) holds the three controllers
+//! and SM's TRANSIT.
 //!
 //! rcsc is built here with the feature `remote-console` (cargo's lock
 //! makes that wait for other builds; `RCSC_BIN` names a ready binary
@@ -179,10 +181,12 @@ fn remote_console_in_tmux_watches_steps_commands_and_sees_a_dead_engine() {
     ]);
     assert!(started.status.success(), "tmux new-session: {started:?}");
     let plans = Path::new(env!("CARGO_MANIFEST_DIR")).join("plans");
+    let trace = dir.join(format!("console-{}.mcap", std::process::id()));
     session.type_text(&format!(
-        "PS1='shell$ '; {} console {} --connect {helm_ep} --connect {engine_ep} --certs {certs}; echo \"console exit status: $?\"",
+        "PS1='shell$ '; {} console {} --connect {helm_ep} --connect {engine_ep} --certs {certs} --trace {}; echo \"console exit status: $?\"",
         rcsc.display(),
         plans.display(),
+        trace.display(),
     ));
     session.keys(&["Enter"]);
 
@@ -279,4 +283,16 @@ fn remote_console_in_tmux_watches_steps_commands_and_sees_a_dead_engine() {
     let alternate = tmux(&["display-message", "-p", "-t", &session.0, "#{alternate_on}"]);
     assert_eq!(String::from_utf8_lossy(&alternate.stdout).trim(), "0");
     helm.assert_running();
+
+    // 6. The recording: every controller, SM on TRANSIT (verb 1).
+    let bytes = std::fs::read(&trace).expect("the recording");
+    let records = rcs_runtime::read_trace_bytes(&bytes).expect("an MCAP recording");
+    let mut names: Vec<&str> = records.iter().map(|r| r.controller.as_str()).collect();
+    names.sort_unstable();
+    names.dedup();
+    assert_eq!(names, ["PR", "SM", "TB"]);
+    assert!(records
+        .iter()
+        .any(|r| r.controller == "SM" && r.verb == Some(1)));
+    let _ = std::fs::remove_file(&trace);
 }

@@ -36,6 +36,10 @@
 //!   not written and [`Bridge::errors`] reports
 //!   [`BridgeError::SchemaMismatch`].
 //!
+//! * **Console** ([`console`]): [`Bridge::serve_console`] publishes the
+//!   executives' figures for a remote console (the `operator` identity) and
+//!   applies its pause / step / resume, from a thread of the bridge.
+//!
 //! The cycle path is untouched: an executive's reads and writes stay
 //! lock-free, allocation-free seqlock copies, and raising the signal is an
 //! atomic swap plus, at most, one futex wake; decoding, encoding and Zenoh

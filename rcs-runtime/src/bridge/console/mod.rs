@@ -26,7 +26,7 @@
 //! (docs/distribution.md "Security"): only the `operator` identity may
 //! subscribe to the figures and put controls.
 //!
-//! Samples use the bridge's wire format ([`super::wire`]): the schema hash
+//! Samples use the bridge's wire format (its `wire` module): the schema hash
 //! of the type, the writer's name and instance, a generation and a cycle,
 //! then the value in postcard. [`command`] encodes a root's command from
 //! its verb and typed arguments for a console that has no generated types.
@@ -39,7 +39,7 @@ use serde::{Deserialize, Serialize};
 use crate::schema::{combine, Schema};
 
 pub(in crate::bridge) use serve::ConsoleService;
-pub use serve::{decode_figures, ConsoleFiguresError};
+pub use serve::{decode_figures, ConsoleFiguresError, MAX_FIGURES_LEN};
 
 /// The identity allowed to watch and control; see [`super::OPERATOR`].
 pub use super::OPERATOR;

@@ -395,31 +395,6 @@ impl Executive {
         self.take_fault()
     }
 
-    /// Run one cycle now unless an operator paused this executive through
-    /// its [`ExecutiveHandle`] (a pending single step runs it, and is used
-    /// up): for programs that drive their executives from a heartbeat loop
-    /// of their own rather than [`run`](Self::run), so that pause / step /
-    /// go work for them too. `Ok(false)`: paused, no cycle ran.
-    pub fn step_unless_paused(&mut self) -> Result<bool, CycleFault> {
-        if !self.may_run() {
-            return Ok(false);
-        }
-        self.run_one();
-        self.take_fault().map(|()| true)
-    }
-
-    /// Whether the next heartbeat runs a cycle: not paused, or paused with
-    /// a single step pending (which this call uses up).
-    fn may_run(&self) -> bool {
-        let paused = self.shared.paused.load(Ordering::Acquire);
-        !paused
-            || self
-                .shared
-                .steps
-                .fetch_update(Ordering::AcqRel, Ordering::Acquire, |s| s.checked_sub(1))
-                .is_ok()
-    }
-
     fn take_fault(&mut self) -> Result<(), CycleFault> {
         match self.fault.take() {
             None => Ok(()),
@@ -607,6 +582,7 @@ impl Executive {
     }
 }
 
+mod driven;
 mod lookup;
 mod monitor;
 pub use monitor::{ControllerFigures, ControllerMonitor, ExecutiveMonitor};

@@ -391,12 +391,12 @@ fn helm(opts: &Options) -> Result<bool, String> {
     let mut silent = 0u32;
     let mut cycle = 0u64;
     while opts.cycles.is_none_or(|n| cycle < n) {
-        heartbeat.wait();
+        let late = heartbeat.wait();
         if let Ok(speed) = order_rx.try_recv() {
             order(&mut system, speed);
             goal_seen = false;
         }
-        if let Err(fault) = cycle_unless_paused(&mut system) {
+        if let Err(fault) = cycle_unless_paused(&mut system, late, heartbeat.missed()) {
             // Contained: the faulty controller's plan ended with HOOK_PANIC.
             eprintln!("submarine-split: {fault}");
         }
@@ -476,8 +476,8 @@ fn engine(opts: &Options) -> Result<bool, String> {
     let mut errors_shown = 0u64;
     let mut cycle = 0u64;
     while opts.cycles.is_none_or(|n| cycle < n) {
-        heartbeat.wait();
-        if let Err(fault) = cycle_unless_paused(&mut system) {
+        let late = heartbeat.wait();
+        if let Err(fault) = cycle_unless_paused(&mut system, late, heartbeat.missed()) {
             // Contained: the faulty controller's plan ended with HOOK_PANIC.
             eprintln!("submarine-split: {fault}");
         }
@@ -514,10 +514,16 @@ fn engine(opts: &Options) -> Result<bool, String> {
 
 /// One cycle of each executive of this process, unless a console paused
 /// it (a single step it asked for runs): `System::run_cycles(1)` for a
-/// main loop that a remote console may pause.
-fn cycle_unless_paused(system: &mut Sub) -> Result<(), rcs_runtime::CycleFault> {
+/// main loop that a remote console may pause. The loop's heartbeat (`late`,
+/// `missed`) goes into the executives' figures.
+fn cycle_unless_paused(
+    system: &mut Sub,
+    late: Duration,
+    missed: u64,
+) -> Result<(), rcs_runtime::CycleFault> {
     let mut fault: Option<rcs_runtime::CycleFault> = None;
     for exec in &mut system.executives {
+        exec.note_heartbeat(late, missed);
         if let Err(f) = exec.step_unless_paused() {
             match &mut fault {
                 Some(first) => first.merge(f),

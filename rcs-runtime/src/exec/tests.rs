@@ -354,3 +354,18 @@ fn a_main_loop_honours_pause_step_and_go() {
     assert_eq!(e.step_unless_paused(), Ok(true));
     assert_eq!(e.cycle(), 4);
 }
+
+#[test]
+fn a_main_loop_notes_its_heartbeats() {
+    let mut e = Executive::new(ExecutiveConfig::new("loop", Duration::from_millis(10))).unwrap();
+    let m = e.attach_monitor(1);
+    let h = e.handle();
+    e.note_heartbeat(Duration::from_micros(250), 2);
+    e.note_heartbeat(Duration::from_micros(100), 3);
+    assert_eq!(
+        (m.lateness_last_ns(), m.lateness_max_ns()),
+        (100_000, 250_000)
+    );
+    assert_eq!(h.missed_heartbeats(), 3);
+    assert_eq!(e.stats().missed_heartbeats, 3);
+}

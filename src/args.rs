@@ -57,7 +57,7 @@ pub(crate) enum Command {
     /// (diagnostics as you type, hover, definition, references, symbols,
     /// completion).
     Lsp,
-    /// Watch and act on a running system: the operator's console (in-process today).
+    /// Watch and act on a running system: the operator's console (over Zenoh with --connect).
     #[cfg(feature = "console")]
     #[command(after_help = crate::console_cmd::CONSOLE_HELP)]
     Console(crate::console_cmd::ConsoleArgs),

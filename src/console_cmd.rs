@@ -1,11 +1,12 @@
-//! `rcsc console PATH [--connect LOCATOR]`: the operator's console for a
-//! running system (issue 31). The console itself (the `rcs-console`
-//! crate) attaches in-process today: a program built from the plan set
-//! runs it on its own terminal (`cargo run -p submarine-example --
-//! --console`). Attaching from a process of its own, over the Zenoh
-//! transport, is phase 2: until then this command checks the plan set,
-//! shows what the console would show of it (CPUs, hierarchy, the verbs an
-//! operator may send to each root) and says how to get the live console.
+//! `rcsc console PATH [--connect ENDPOINT… --certs DIR]`: the operator's
+//! console for a running system (issue 31). Without `--connect` it checks
+//! the plan set and shows what the console shows of it (CPUs, hierarchy,
+//! the verbs an operator may send to each root): a program built from the
+//! plan set runs the console in-process (`cargo run -p submarine-example --
+//! --console`). With `--connect` (feature `remote-console`) it attaches to
+//! a distributed plan set's running processes over Zenoh as the identity
+//! `operator` ([`rcs_console::remote`]), under the operator's
+//! access-control policy generated from the plan set.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -15,26 +16,47 @@ use rcs_console::Catalog;
 use crate::output::fail;
 
 pub(crate) const CONSOLE_HELP: &str = "\
-Today the console attaches in-process: a program built from the plan set
-runs it on its terminal, its executives on their threads. The submarine
-example does: `cargo run -p submarine-example -- --console` (docs/console.md:
-the keys, what it shows). Attaching to a running system from a process of
-its own (--connect, over the Zenoh transport) arrives in phase 2; until then
-`rcsc console PATH` checks the plan set and lists what the console shows of
+Without --connect, checks the plan set and lists what the console shows of
 it: the CPUs, the hierarchy, and the verbs an operator may send to each
-root.
+root. A program built from the plan set can run the console in-process:
+`cargo run -p submarine-example -- --console` (docs/console.md: the keys,
+what it shows).
+
+With --connect, attaches to the running processes of a distributed plan set
+over Zenoh (rcsc built with the feature `remote-console`), as the identity
+`operator`: mutual TLS with DIR/ca.pem, DIR/operator.pem and
+DIR/operator.key (`rcsc certs DIR PLANS` makes development ones), under the
+operator's access-control policy generated from the plan set. Give one
+--connect per process (peers do not relay each other's samples). Each
+process must serve the console (`Bridge::serve_console`); the operator may
+watch, pause / step / resume executives and command the roots, nothing else.
 
 Examples:
   rcsc console plans/submarine
-  cargo run -p submarine-example -- --console";
+  rcsc console examples/submarine-split/plans --connect tls/127.0.0.1:7447 \\
+      --connect tls/127.0.0.1:7448 --certs /tmp/sub --trace session.mcap";
 
 #[derive(clap::Args)]
 pub(crate) struct ConsoleArgs {
     /// The plan set the running system was built from (a plan-set folder).
     pub(crate) path: PathBuf,
-    /// Attach to a running system over Zenoh at LOCATOR (phase 2: not yet).
-    #[arg(long, value_name = "LOCATOR")]
-    pub(crate) connect: Option<String>,
+    /// Attach over Zenoh to the process listening at ENDPOINT
+    /// (`tls/HOST:PORT`); repeat for each process.
+    #[arg(long, value_name = "ENDPOINT")]
+    pub(crate) connect: Vec<String>,
+    /// The operator's certificates: DIR/ca.pem, DIR/operator.pem,
+    /// DIR/operator.key.
+    #[arg(long, value_name = "DIR")]
+    pub(crate) certs: Option<PathBuf>,
+    /// Connect without TLS or access control (`tcp/` endpoints), to
+    /// processes run with `--insecure`.
+    #[arg(long)]
+    pub(crate) insecure: bool,
+    /// Record the session to FILE (with --connect): MCAP when it ends in
+    /// `.mcap`, else JSON lines; one message per controller whose figures
+    /// changed, about ten times a second.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) trace: Option<PathBuf>,
 }
 
 pub(crate) fn console(args: ConsoleArgs) -> ExitCode {
@@ -42,20 +64,98 @@ pub(crate) fn console(args: ConsoleArgs) -> ExitCode {
         Ok(c) => c,
         Err(e) => return fail(e),
     };
-    if let Some(locator) = args.connect {
-        return fail(format!(
-            "attaching to a running system over Zenoh ({locator}) arrives in phase 2 of the \
-             console (issue 31); today run the program with its in-process console, e.g. \
-             `cargo run -p submarine-example -- --console`"
-        ));
+    if !args.connect.is_empty() {
+        return remote(&args, catalog);
+    }
+    if args.certs.is_some() || args.insecure || args.trace.is_some() {
+        return fail("--certs, --insecure and --trace go with --connect ENDPOINT");
     }
     print!("{}", summary(&catalog));
     eprintln!(
-        "note: `rcsc console` attaches to a running system from another process in phase 2 \
-         (issue 31); today the console runs in-process: \
-         `cargo run -p submarine-example -- --console` (docs/console.md)"
+        "note: `rcsc console PATH --connect ENDPOINT --certs DIR` attaches to a running \
+         distributed system; `cargo run -p submarine-example -- --console` runs the console \
+         in-process (docs/console.md)"
     );
     ExitCode::SUCCESS
+}
+
+#[cfg(not(feature = "remote-console"))]
+fn remote(args: &ConsoleArgs, _catalog: Catalog) -> ExitCode {
+    fail(format!(
+        "attaching over Zenoh ({}) needs rcsc built with the feature `remote-console` \
+         (cargo install rcsc --features remote-console)",
+        args.connect.join(", ")
+    ))
+}
+
+#[cfg(feature = "remote-console")]
+fn remote(args: &ConsoleArgs, catalog: Catalog) -> ExitCode {
+    use rcs_runtime::bridge::console::OPERATOR;
+    use rcs_runtime::BridgeConfig;
+
+    let mut config = BridgeConfig::new(&catalog.system, OPERATOR);
+    for e in &args.connect {
+        config = config.connect(e);
+    }
+    config =
+        match (&args.certs, args.insecure) {
+            (Some(dir), false) => config.certs(dir),
+            (None, true) => config.insecure(),
+            _ => return fail(
+                "choose --certs DIR (the operator's certificate, mutual TLS and access control) \
+                 or --insecure (neither)",
+            ),
+        };
+    config.policy = match operator_policy(&args.path) {
+        Ok(p) => Some(p),
+        Err(e) => return fail(e),
+    };
+    let mut source = match rcs_console::remote::Remote::connect(catalog.clone(), &config) {
+        Ok(s) => s,
+        Err(e) => return fail(format!("cannot attach: {e}")),
+    };
+    let Some(path) = &args.trace else {
+        return match rcs_console::run(catalog, &mut source) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => fail(format!("terminal: {e}")),
+        };
+    };
+    let sink = match rcs_runtime::TraceSink::create(path) {
+        Ok(s) => s,
+        Err(e) => return fail(format!("cannot write {}: {e}", path.display())),
+    };
+    let mut recording = rcs_console::Recording::new(&mut source, sink, catalog.clone());
+    let ran = rcs_console::run(catalog, &mut recording);
+    let finished = recording.finish();
+    match (ran, finished) {
+        (Err(e), _) => fail(format!("terminal: {e}")),
+        (Ok(()), Err(e)) => fail(format!("cannot finish {}: {e}", path.display())),
+        (Ok(()), Ok((records, lost))) => {
+            eprintln!(
+                "recorded {records} message(s) to {}{}",
+                path.display(),
+                if lost > 0 {
+                    format!(" ({lost} lost to write errors)")
+                } else {
+                    String::new()
+                }
+            );
+            ExitCode::SUCCESS
+        }
+    }
+}
+
+/// The operator's access-control policy for the plan set at `path`.
+#[cfg(feature = "remote-console")]
+fn operator_policy(path: &std::path::Path) -> Result<String, String> {
+    let set = rcs_dsl::load_folder(path)
+        .map_err(|e| format!("cannot load the plan set {}: {e}", path.display()))?;
+    let checked = rcs_dsl::check(&set, &rcs_dsl::Options::default());
+    let ir = checked
+        .ir
+        .ok_or_else(|| format!("the plan set {} has errors", path.display()))?;
+    let placement = rcs_dsl::placement::Placement::of(&ir);
+    Ok(rcs_codegen::acl::operator_policy(&ir, &placement).to_string())
 }
 
 /// What the console would show of a plan set before it runs.

@@ -124,6 +124,9 @@ pub struct Catalog {
     pub controllers: Vec<ControllerInfo>,
     /// The schedule.
     pub cpus: Vec<CpuInfo>,
+    /// The processes the manifest places the CPUs in (one, `main`, for a
+    /// plan set in one process), in the order the schedule names them.
+    pub processes: Vec<String>,
 }
 
 impl Catalog {
@@ -203,6 +206,7 @@ impl Catalog {
             system: ir.system.clone(),
             controllers,
             cpus,
+            processes: rcs_dsl::placement::Placement::of(ir).processes,
         }
     }
 

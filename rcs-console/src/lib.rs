@@ -18,6 +18,9 @@
 //! - [`catalog`]: the plan set's names, parameter types and plan tables;
 //! - [`model`]: plain-data snapshots and the model the view draws;
 //! - [`source`]: the [`Source`] trait and the in-process attachment;
+//! - [`record`]: recording a session to a trace (MCAP or JSON lines);
+//! - `remote` (feature `zenoh`): the console as a process of its own,
+//!   attached over the Zenoh transport of a distributed plan set;
 //! - [`app`]: keys and prompts; [`view`]: drawing; `term`: the terminal.
 //!
 //! The console never blocks or slows a control cycle: it reads atomics and
@@ -26,6 +29,9 @@
 pub mod app;
 pub mod catalog;
 pub mod model;
+pub mod record;
+#[cfg(feature = "zenoh")]
+pub mod remote;
 pub mod source;
 mod term;
 pub mod view;
@@ -33,6 +39,7 @@ pub mod view;
 pub use app::App;
 pub use catalog::{ArgValue, Catalog};
 pub use model::{Model, Snapshot};
+pub use record::Recording;
 pub use source::{Commander, InProcess, Source};
 pub use term::run;
 

@@ -2,7 +2,7 @@
 //! once per refresh, and the names the [`Catalog`] gives the numbers.
 //!
 //! A [`Snapshot`] is what the running system says at one moment (ids and
-//! counters only, so that phase 2 can ship it across processes as it is);
+//! counters only; the remote source builds it from what processes publish);
 //! [`Model`] keeps the latest one with the catalog and the hit counts seen
 //! at attach, so that the view shows hits *since attach*.
 
@@ -32,6 +32,9 @@ pub struct CpuSnapshot {
     pub lateness_last_ns: u64,
     /// The latest a heartbeat woke, ns.
     pub lateness_max_ns: u64,
+    /// How long its process has not been heard from, ms, once that is
+    /// long enough to be news (a remote source; `None` in-process).
+    pub silent_ms: Option<u64>,
 }
 
 /// One controller at one moment.

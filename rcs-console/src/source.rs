@@ -2,10 +2,11 @@
 //! the [`Source`] trait, and [`InProcess`], the attachment to executives
 //! running on threads of the console's own process.
 //!
-//! Phase 2 adds a Zenoh source (the console as a process of its own, reading
-//! the monitors' figures and status buffers over the bridge, and sending
-//! executive controls and the operator's commands back); the view and the
-//! model only ever see this trait.
+//! The Zenoh source, [`Remote`](crate::remote::Remote) (feature `zenoh`),
+//! is the console as a process of its own: it reads the figures each
+//! process's bridge publishes and sends executive controls and the
+//! operator's commands back. The view and the model only ever see this
+//! trait.
 
 use std::sync::Arc;
 
@@ -108,6 +109,7 @@ impl Source for InProcess {
                 cycle_max_ns: m.cycle_max_ns(),
                 lateness_last_ns: m.lateness_last_ns(),
                 lateness_max_ns: m.lateness_max_ns(),
+                silent_ms: None,
             });
             for (c, status) in m.controllers().iter().zip(&cpu.status) {
                 let f = c.figures();

@@ -38,7 +38,11 @@ pub fn cpu_line(cpu: &CpuSnapshot) -> String {
     format!(
         "CPU {} | {} | cycle {} | period {} ms | cycle µs {}/{} max | late µs {}/{} max | overruns {} | missed {}",
         cpu.name,
-        if cpu.paused { "PAUSED" } else { "RUN" },
+        match (cpu.silent_ms, cpu.paused) {
+            (Some(ms), _) => format!("SILENT {:.1} s", ms as f64 / 1e3),
+            (None, true) => "PAUSED".into(),
+            (None, false) => "RUN".into(),
+        },
         cpu.cycle,
         cpu.period_ns as f64 / 1e6,
         micros(cpu.cycle_last_ns),

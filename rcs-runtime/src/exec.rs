@@ -212,6 +212,17 @@ impl ExecutiveHandle {
         self.shared.paused.store(true, Ordering::SeqCst);
         self.shared.steps.fetch_add(1, Ordering::SeqCst);
     }
+    /// Pause, and run exactly `n` more cycles, one per heartbeat (run N;
+    /// `step_by(1)` is [`step`](Self::step)).
+    pub fn step_by(&self, n: u64) {
+        self.shared.paused.store(true, Ordering::SeqCst);
+        let _ = self
+            .shared
+            .steps
+            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |s| {
+                Some(s.saturating_add(n))
+            });
+    }
     /// Run freely again.
     pub fn go(&self) {
         self.shared.steps.store(0, Ordering::SeqCst);
@@ -416,14 +427,7 @@ impl Executive {
                 break;
             }
             beats += 1;
-            let paused = self.shared.paused.load(Ordering::Acquire);
-            let stepping = paused
-                && self
-                    .shared
-                    .steps
-                    .fetch_update(Ordering::AcqRel, Ordering::Acquire, |s| s.checked_sub(1))
-                    .is_ok();
-            if !paused || stepping {
+            if self.may_run() {
                 self.run_one();
                 // On the heartbeat, panics live on in the statistics
                 // (`panics`, `last_panic`) rather than piling up here.
@@ -578,6 +582,7 @@ impl Executive {
     }
 }
 
+mod driven;
 mod lookup;
 mod monitor;
 pub use monitor::{ControllerFigures, ControllerMonitor, ExecutiveMonitor};

@@ -26,6 +26,14 @@
 //! again and order again: the hierarchy recovers. `one-process` runs the same
 //! plan set with `System::new` in one process, flat out, for comparison.
 //!
+//! Both processes serve a remote console (`Bridge::serve_console`): `rcsc
+//! console examples/submarine-split/plans --connect HELM --connect ENGINE
+//! --certs DIR` (the `operator` certificate) shows their controllers live,
+//! pauses, steps and resumes their executives (the main loops run each
+//! cycle through `Executive::step_unless_paused`) and commands SM
+//! (docs/console.md). Give the engine a `--listen` endpoint of its own for
+//! that: peers do not relay each other's samples.
+//!
 //! `--report-generations` makes both processes check, every cycle, that
 //! what the bridge imports never arrives out of order (`generations.rs`;
 //! the fault tests in `tests/netns_faults.rs` use it). The crate's second

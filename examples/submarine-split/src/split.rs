@@ -23,7 +23,7 @@ use submarine_split::{pr, sm, tb, Hooks, System};
 /// The split submarine with PR's hooks.
 type Sub = System<Propulsion>;
 
-const USAGE: &str = "usage: submarine-split helm|engine|one-process (--certs DIR | --insecure) [--listen ENDPOINT] [--connect ENDPOINT] [--speed KNOTS] [--cycles N] [--report-every N] [--report-generations]
+const USAGE: &str = "usage: submarine-split helm|engine|one-process (--certs DIR | --insecure) [--listen ENDPOINT] [--connect ENDPOINT] [--speed KNOTS] [--cycles N] [--report-every N] [--report-generations] [--no-order]
 
   helm         SM and PR; listens on tls/127.0.0.1:7447; orders SM <- TRANSIT(speed) once TB answers;
                `transit KNOTS` on standard input orders again
@@ -34,6 +34,8 @@ const USAGE: &str = "usage: submarine-split helm|engine|one-process (--certs DIR
                and the access-control policy rcsc generated for the process
   --insecure   no TLS, no access control (tcp/ endpoints): anyone on the network can command the ship
   --cycles N   stop after N cycles (default: run until killed; one-process: 2000)
+  --no-order   the helm orders nothing itself: orders come from standard input or an operator
+               (a console: `rcsc console PLANS --connect …`)
   --report-every N  also print a `report` line every N cycles: the helm the ship's speed and age,
                the engine the turbine's drive, both the bridge's refused samples
   --report-generations
@@ -44,6 +46,10 @@ const USAGE: &str = "usage: submarine-split helm|engine|one-process (--certs DIR
 /// PR's watchdog row E2 fires when `TB.stale_cycles` exceeds this
 /// (`plans/propulsion.rcs`).
 const WATCHDOG_BOUND: u32 = 30;
+
+/// Hit counters per verb for a remote console: more than the longest plan
+/// of `plans/` (rows beyond would be counted as dropped, not shown).
+const CONSOLE_ROWS: usize = 16;
 
 /// The helm's port, which the engine connects to.
 const DEFAULT_PORT: &str = "127.0.0.1:7447";
@@ -137,6 +143,9 @@ struct Options {
     insecure: bool,
     report_every: Option<u64>,
     report_generations: bool,
+    /// The helm waits for orders (stdin, or a remote operator) instead of
+    /// ordering TRANSIT(speed) itself.
+    no_order: bool,
 }
 
 impl Options {
@@ -157,11 +166,13 @@ impl Options {
             insecure: false,
             report_every: None,
             report_generations: false,
+            no_order: false,
         };
         while let Some(arg) = args.next() {
             let mut value = || args.next().ok_or(format!("{arg} needs a value"));
             match arg.as_str() {
                 "--report-generations" => opts.report_generations = true,
+                "--no-order" => opts.no_order = true,
                 "--listen" => opts.listen = Some(value()?),
                 "--certs" => opts.certs = Some(value()?.into()),
                 "--insecure" => opts.insecure = true,
@@ -318,8 +329,11 @@ fn report_bridge_errors(bridge: &rcs_runtime::Bridge, shown: &mut u64) {
 /// SM and PR: wait for TB, order TRANSIT, print status changes; orders from
 /// standard input. Returns whether PR reached AT_GOAL at least once.
 fn helm(opts: &Options) -> Result<bool, String> {
-    let (mut system, bridge) =
+    let (mut system, mut bridge) =
         Sub::process("helm", opts.bridge(), Hooks { pr: PROPULSION }).map_err(|e| e.to_string())?;
+    bridge
+        .serve_console(&system.gm, &mut system.executives, CONSOLE_ROWS)
+        .map_err(|e| e.to_string())?;
     let tb_status = system
         .gm
         .reader::<StatusBuffer>(&rcs_runtime::status_buffer_name(tb::NAME))
@@ -362,7 +376,9 @@ fn helm(opts: &Options) -> Result<bool, String> {
         system.operators.sm.command(sm::Command::Transit { speed });
         println!("order SM <- TRANSIT(speed: {speed:.2})");
     };
-    order(&mut system, opts.speed);
+    if !opts.no_order {
+        order(&mut system, opts.speed);
+    }
     let period = system
         .executives
         .first()
@@ -375,12 +391,12 @@ fn helm(opts: &Options) -> Result<bool, String> {
     let mut silent = 0u32;
     let mut cycle = 0u64;
     while opts.cycles.is_none_or(|n| cycle < n) {
-        heartbeat.wait();
+        let late = heartbeat.wait();
         if let Ok(speed) = order_rx.try_recv() {
             order(&mut system, speed);
             goal_seen = false;
         }
-        if let Err(fault) = system.run_cycles(1) {
+        if let Err(fault) = cycle_unless_paused(&mut system, late, heartbeat.missed()) {
             // Contained: the faulty controller's plan ended with HOOK_PANIC.
             eprintln!("submarine-split: {fault}");
         }
@@ -426,7 +442,10 @@ fn helm(opts: &Options) -> Result<bool, String> {
 
 /// TB with the simulated turbine and ship, on its own heartbeat.
 fn engine(opts: &Options) -> Result<bool, String> {
-    let (mut system, bridge) = Sub::process("engine", opts.bridge(), Hooks { pr: PROPULSION })
+    let (mut system, mut bridge) = Sub::process("engine", opts.bridge(), Hooks { pr: PROPULSION })
+        .map_err(|e| e.to_string())?;
+    bridge
+        .serve_console(&system.gm, &mut system.executives, CONSOLE_ROWS)
         .map_err(|e| e.to_string())?;
     let period = system
         .executives
@@ -457,8 +476,8 @@ fn engine(opts: &Options) -> Result<bool, String> {
     let mut errors_shown = 0u64;
     let mut cycle = 0u64;
     while opts.cycles.is_none_or(|n| cycle < n) {
-        heartbeat.wait();
-        if let Err(fault) = system.run_cycles(1) {
+        let late = heartbeat.wait();
+        if let Err(fault) = cycle_unless_paused(&mut system, late, heartbeat.missed()) {
             // Contained: the faulty controller's plan ended with HOOK_PANIC.
             eprintln!("submarine-split: {fault}");
         }
@@ -491,6 +510,28 @@ fn engine(opts: &Options) -> Result<bool, String> {
         cycle += 1;
     }
     Ok(true)
+}
+
+/// One cycle of each executive of this process, unless a console paused
+/// it (a single step it asked for runs): `System::run_cycles(1)` for a
+/// main loop that a remote console may pause. The loop's heartbeat (`late`,
+/// `missed`) goes into the executives' figures.
+fn cycle_unless_paused(
+    system: &mut Sub,
+    late: Duration,
+    missed: u64,
+) -> Result<(), rcs_runtime::CycleFault> {
+    let mut fault: Option<rcs_runtime::CycleFault> = None;
+    for exec in &mut system.executives {
+        exec.note_heartbeat(late, missed);
+        if let Err(f) = exec.step_unless_paused() {
+            match &mut fault {
+                Some(first) => first.merge(f),
+                None => fault = Some(f),
+            }
+        }
+    }
+    fault.map_or(Ok(()), Err)
 }
 
 /// The same hierarchy and simulators in one process, flat out: prints the

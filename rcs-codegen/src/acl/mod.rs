@@ -18,6 +18,10 @@
 //!   reads; what Q may put to it and subscribe at it is the mirror image;
 //! * the operator may put the command buffers of the roots that run in
 //!   the process and subscribe to the status buffers of its controllers;
+//! * the operator (and no one else) may subscribe to the process's console
+//!   figures (`rcs/SYSTEM/_console/PROCESS/figures`) and put executive
+//!   controls (pause, step, resume) on `rcs/SYSTEM/_console/PROCESS/control`
+//!   (the keys of `rcs_runtime::bridge::console`);
 //! * everything else is denied (`default_permission: deny`): a wildcard
 //!   subscription such as `rcs/**`, a put to any other key, queries,
 //!   liveliness;
@@ -99,6 +103,9 @@ pub fn policy(ir: &Ir, placement: &Placement, process: usize) -> Value {
         .iter()
         .map(|&c| key(&format!("{}.status", ir.controllers[c].name)))
         .collect();
+    let name = &placement.processes[process];
+    let figures = vec![console_key(ir, name, "figures")];
+    let control = vec![console_key(ir, name, "control")];
     let ids: Vec<String> = [
         acl.allow(
             format!("commands_from_{OPERATOR}"),
@@ -119,6 +126,25 @@ pub fn policy(ir: &Ir, placement: &Placement, process: usize) -> Value {
             statuses.clone(),
         ),
         acl.allow(format!("statuses_to_{OPERATOR}"), "egress", "put", statuses),
+        acl.allow(
+            format!("{OPERATOR}_may_watch"),
+            "ingress",
+            "declare_subscriber",
+            figures.clone(),
+        ),
+        acl.allow(format!("figures_to_{OPERATOR}"), "egress", "put", figures),
+        acl.allow(
+            format!("controls_from_{OPERATOR}"),
+            "egress",
+            "declare_subscriber",
+            control.clone(),
+        ),
+        acl.allow(
+            format!("{OPERATOR}_may_control"),
+            "ingress",
+            "put",
+            control.clone(),
+        ),
     ]
     .into_iter()
     .flatten()
@@ -138,6 +164,13 @@ pub fn policy(ir: &Ir, placement: &Placement, process: usize) -> Value {
             "size_limit": wire_bound(ir, &x.kind),
         }));
     }
+    filters.push(json!({
+        "id": "size_console_control",
+        "flows": ["ingress"],
+        "messages": ["put"],
+        "key_exprs": control,
+        "size_limit": CONTROL_BOUND,
+    }));
     let mut subjects: Vec<Value> = placement
         .processes
         .iter()
@@ -169,6 +202,8 @@ pub fn operator_policy(ir: &Ir, placement: &Placement) -> Value {
         let statuses: Vec<String> = here
             .map(|c| key(format!("{}.status", ir.controllers[c].name)))
             .collect();
+        let figures = vec![console_key(ir, process, "figures")];
+        let control = vec![console_key(ir, process, "control")];
         let mut ids = Vec::new();
         for (id, flow, message, keys) in [
             (
@@ -190,6 +225,20 @@ pub fn operator_policy(ir: &Ir, placement: &Placement) -> Value {
                 "declare_subscriber",
                 &statuses,
             ),
+            (format!("figures_of_{process}"), "ingress", "put", &figures),
+            (
+                format!("watch_{process}"),
+                "egress",
+                "declare_subscriber",
+                &figures,
+            ),
+            (
+                format!("{process}_takes_controls"),
+                "ingress",
+                "declare_subscriber",
+                &control,
+            ),
+            (format!("control_{process}"), "egress", "put", &control),
         ] {
             ids.extend(acl.allow(id, flow, message, keys.clone()));
         }
@@ -202,6 +251,17 @@ pub fn operator_policy(ir: &Ir, placement: &Placement) -> Value {
         .collect();
     json!({ "access_control": acl.into_json(subjects) })
 }
+
+/// The console key `rcs/SYSTEM/_console/PROCESS/WHAT` (`figures` or
+/// `control`), as `rcs_runtime::bridge::console` names them.
+fn console_key(ir: &Ir, process: &str, what: &str) -> String {
+    format!("rcs/{}/_console/{process}/{what}", ir.system)
+}
+
+/// The size limit of an executive control: the runtime's
+/// `console::CONTROL_MAX_LEN` (a wire header of 297 bytes, an executive
+/// name of up to 255, 32 for the action) with the same margin as buffers.
+const CONTROL_BOUND: u64 = 297 + 255 + 32 + 64;
 
 /// Zenoh's `access_control` as it is built: allow rules, and which subject
 /// holds which (everything else denied).

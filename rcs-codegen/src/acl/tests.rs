@@ -74,6 +74,18 @@ fn expected(ir: &Ir, pl: &Placement, p: usize) -> BTreeSet<(String, String, Stri
             add(w, "egress", "declare_subscriber", key(x));
         }
     }
+    // The console: the operator alone watches the figures and controls
+    // the executives.
+    let console = |what: &str| format!("rcs/{}/_console/{}/{what}", ir.system, pl.processes[p]);
+    add(OPERATOR, "egress", "put", console("figures"));
+    add(
+        OPERATOR,
+        "ingress",
+        "declare_subscriber",
+        console("figures"),
+    );
+    add(OPERATOR, "ingress", "put", console("control"));
+    add(OPERATOR, "egress", "declare_subscriber", console("control"));
     for (c, ctrl) in ir.controllers.iter().enumerate() {
         if pl.ctrl_process[c] != p {
             continue;
@@ -129,7 +141,11 @@ fn each_put_has_a_size_limit_and_the_file_is_a_zenoh_config() {
         .iter()
         .filter(|x| x.readers.contains(&0))
         .count();
-    assert_eq!(filters.len(), imported);
+    // One per imported buffer, and the console's controls.
+    assert_eq!(filters.len(), imported + 1);
+    assert!(filters.iter().any(|f| f["key_exprs"][0]
+        == "rcs/submarine_split/_console/helm/control"
+        && f["size_limit"].as_u64() >= Some(584)));
     for f in filters {
         let limit = f["size_limit"].as_u64().unwrap();
         assert!((300..10_000).contains(&limit), "{f}");
@@ -165,5 +181,11 @@ fn the_operator_policy_mirrors_the_processes() {
         "egress".into(),
         "put".into(),
         "rcs/submarine_split/SM.command".into()
+    )));
+    assert!(op.contains(&(
+        "engine".into(),
+        "egress".into(),
+        "put".into(),
+        "rcs/submarine_split/_console/engine/control".into()
     )));
 }

@@ -36,12 +36,17 @@
 //!   not written and [`Bridge::errors`] reports
 //!   [`BridgeError::SchemaMismatch`].
 //!
+//! * **Console** ([`console`]): [`Bridge::serve_console`] publishes the
+//!   executives' figures for a remote console (the `operator` identity) and
+//!   applies its pause / step / resume, from a thread of the bridge.
+//!
 //! The cycle path is untouched: an executive's reads and writes stay
 //! lock-free, allocation-free seqlock copies, and raising the signal is an
 //! atomic swap plus, at most, one futex wake; decoding, encoding and Zenoh
 //! itself run on the bridge's and Zenoh's threads.
 
 mod config;
+pub mod console;
 mod error;
 mod export;
 mod import;
@@ -101,6 +106,9 @@ pub struct BridgeBuilder<'a> {
     /// This bridge's random instance number, sent with every sample so that
     /// importers tell a restarted (or duplicated) writer apart.
     instance: u64,
+    /// The roots whose commands a remote operator may send here, for a
+    /// console ([`Bridge::serve_console`]).
+    roots: Vec<console::RootCommand>,
 }
 
 impl std::fmt::Debug for BridgeBuilder<'_> {
@@ -173,6 +181,10 @@ impl<'a> BridgeBuilder<'a> {
         C: crate::handshake::Command + Schema + DeserializeOwned + Sync,
     {
         let name = crate::command_buffer_name(root);
+        self.roots.push(console::RootCommand {
+            root: root.to_owned(),
+            schema: <crate::CommandBuffer<C> as Schema>::SCHEMA,
+        });
         self.subscribe(
             &name,
             OPERATOR,
@@ -259,6 +271,9 @@ impl<'a> BridgeBuilder<'a> {
         };
         Ok(Bridge {
             config: self.config,
+            instance: self.instance,
+            roots: self.roots,
+            console: None,
             session: Some(session),
             subscribers,
             stop,
@@ -273,6 +288,10 @@ impl<'a> BridgeBuilder<'a> {
 /// the export thread. Dropping it stops the thread and closes the session.
 pub struct Bridge {
     config: BridgeConfig,
+    instance: u64,
+    roots: Vec<console::RootCommand>,
+    /// The remote console's service, once [`Bridge::serve_console`] ran.
+    console: Option<console::ConsoleService>,
     /// `None` once closed.
     session: Option<Session>,
     subscribers: Vec<Subscriber<()>>,
@@ -300,6 +319,7 @@ impl Bridge {
             exports: Vec::new(),
             imports: Vec::new(),
             instance: random_instance(),
+            roots: Vec::new(),
         }
     }
 
@@ -368,6 +388,9 @@ impl Bridge {
     }
 
     fn shut_down(&mut self) {
+        if let Some(mut c) = self.console.take() {
+            c.shut_down();
+        }
         self.stop.store(true, Ordering::Release);
         self.signal.raise();
         if let Some(t) = self.exporter.take() {
@@ -379,6 +402,64 @@ impl Bridge {
         if let Some(session) = self.session.take() {
             let _ = session.close().wait();
         }
+    }
+
+    /// Let a remote console (the `operator` identity, under the generated
+    /// access-control policy) watch `executives` and pause, step and resume
+    /// them ([`console`]): attaches a monitor to each (hit counters for
+    /// `rows_per_verb` rows of each verb's plan, the plan set's longest) and
+    /// starts publishing their figures, with the stamps of their
+    /// controllers' status buffers in `gm`, every
+    /// [`console::DISPLAY_PERIOD`] from a thread of the bridge. Call once
+    /// the executives are set up, before they run or are spawned (a
+    /// program that drives them from its own loop calls
+    /// [`Executive::step_unless_paused`](crate::Executive::step_unless_paused)
+    /// so that pause and step apply). Calling again replaces the service.
+    pub fn serve_console(
+        &mut self,
+        gm: &GlobalMemory,
+        executives: &mut [crate::Executive],
+        rows_per_verb: usize,
+    ) -> Result<(), BridgeError> {
+        let watched = executives
+            .iter_mut()
+            .map(|e| {
+                let monitor = e.attach_monitor(rows_per_verb);
+                (e.handle(), monitor)
+            })
+            .collect();
+        self.serve_console_of(gm, watched)
+    }
+
+    /// As [`serve_console`](Self::serve_console), for executives whose
+    /// monitors are already attached (e.g. shared with an in-process
+    /// console).
+    pub fn serve_console_of(
+        &mut self,
+        gm: &GlobalMemory,
+        executives: Vec<(crate::ExecutiveHandle, Arc<crate::ExecutiveMonitor>)>,
+    ) -> Result<(), BridgeError> {
+        if let Some(mut old) = self.console.take() {
+            old.shut_down();
+        }
+        let session = self
+            .session
+            .as_ref()
+            .ok_or_else(|| BridgeError::Zenoh("the bridge is closed".into()))?;
+        let watched = executives
+            .into_iter()
+            .map(|(handle, monitor)| console::serve::Watched::new(gm, handle, monitor))
+            .collect();
+        self.console = Some(console::ConsoleService::start(
+            session,
+            &self.config.system,
+            &self.config.process,
+            self.instance,
+            watched,
+            self.roots.clone(),
+            Arc::clone(&self.shared.errors),
+        )?);
+        Ok(())
     }
 
     /// The name of the export thread, `rcs-bridge-<process>` (what

@@ -34,7 +34,7 @@ pub(crate) const MAX_NAME: usize = 255;
 
 /// The longest header: four varints of at most ten bytes, and a process
 /// name with its length.
-const MAX_HEADER: usize = 4 * 10 + 2 + MAX_NAME;
+pub(crate) const MAX_HEADER: usize = 4 * 10 + 2 + MAX_NAME;
 
 /// The longest encoding of a value of type `T`, with margin: postcard
 /// writes no integer or enum tag in more than twice its size in memory,

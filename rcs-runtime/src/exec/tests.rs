@@ -336,3 +336,36 @@ fn a_monitor_publishes_state_rows_fired_and_hit_counts() -> Result<(), SetupErro
     assert_eq!(monitor.name(), "cpu");
     Ok(())
 }
+
+#[test]
+fn a_main_loop_honours_pause_step_and_go() {
+    let mut e = Executive::new(ExecutiveConfig::new("loop", Duration::from_millis(10))).unwrap();
+    let h = e.handle();
+    assert_eq!(e.step_unless_paused(), Ok(true));
+    h.pause();
+    assert_eq!(e.step_unless_paused(), Ok(false));
+    assert_eq!(e.cycle(), 1);
+    h.step_by(2);
+    assert_eq!(e.step_unless_paused(), Ok(true));
+    assert_eq!(e.step_unless_paused(), Ok(true));
+    assert_eq!(e.step_unless_paused(), Ok(false));
+    assert_eq!((e.cycle(), h.cycle(), h.pending_steps()), (3, 3, 0));
+    h.go();
+    assert_eq!(e.step_unless_paused(), Ok(true));
+    assert_eq!(e.cycle(), 4);
+}
+
+#[test]
+fn a_main_loop_notes_its_heartbeats() {
+    let mut e = Executive::new(ExecutiveConfig::new("loop", Duration::from_millis(10))).unwrap();
+    let m = e.attach_monitor(1);
+    let h = e.handle();
+    e.note_heartbeat(Duration::from_micros(250), 2);
+    e.note_heartbeat(Duration::from_micros(100), 3);
+    assert_eq!(
+        (m.lateness_last_ns(), m.lateness_max_ns()),
+        (100_000, 250_000)
+    );
+    assert_eq!(h.missed_heartbeats(), 3);
+    assert_eq!(e.stats().missed_heartbeats, 3);
+}

@@ -145,3 +145,6 @@ fn is_optional_separator(t: &SyntaxToken) -> bool {
         _ => false,
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -300,3 +300,26 @@ proptest! {
         }
     }
 }
+
+/// The property above says something only if mutated cases still check
+/// clean: most of them must, for a fixed seed.
+#[test]
+fn most_mutations_still_check_clean() {
+    let cases = ok_cases();
+    let clean = cases
+        .iter()
+        .filter(|case| {
+            let files: Vec<(String, String)> = case
+                .files
+                .iter()
+                .map(|(p, t)| (p.clone(), mutate(t, 0x5eed)))
+                .collect();
+            ir_without_spans(&case.name, &files, case.manifest.as_deref()).is_some()
+        })
+        .count();
+    assert!(
+        clean * 10 >= cases.len() * 8,
+        "{clean} of {} mutated cases check clean",
+        cases.len()
+    );
+}

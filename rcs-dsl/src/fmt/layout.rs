@@ -248,6 +248,7 @@ impl<'a> Layout<'a> {
             {
                 self.params_one_per_line(node, out)
             }
+            K::CommandDecl if !self.fits(node, out) => self.wrapped_accept(node, out),
             K::PlanDef | K::RowsDef => {
                 self.braced(node, out, |this, body, out| this.rows(body, out));
             }
@@ -281,6 +282,44 @@ impl<'a> Layout<'a> {
         for el in &elements[close..] {
             self.flow_element(el, out);
         }
+    }
+
+    /// Whether `node` fits on the current line (or holds a comment, which
+    /// keeps its own line breaks).
+    fn fits(&self, node: &SyntaxNode, out: &Out) -> bool {
+        self.one_line(node).is_none_or(|line| {
+            out.line_len().max(out.indent) + line.chars().count() <= self.max_width
+        })
+    }
+
+    /// `command VERB(…) accept when COND` too long for the width: the
+    /// condition broken before its loosest `&&` or `||` as a row's is.
+    fn wrapped_accept(&self, node: &SyntaxNode, out: &mut Out) {
+        let accept = node.children().find(|c| c.kind() == K::AcceptClause);
+        let expr = accept
+            .as_ref()
+            .and_then(|a| a.children().find(|c| c.kind() == K::Expr));
+        let (Some(accept), Some(segments)) = (accept.clone(), expr.and_then(|e| self.segments(&e)))
+        else {
+            self.flow_node(node, out);
+            return;
+        };
+        for el in node.children_with_tokens() {
+            if el.as_node() == Some(&accept) {
+                break;
+            }
+            self.flow_element(&el, out);
+        }
+        let mut first = Out::new(0);
+        for el in accept.children_with_tokens() {
+            if el.kind() == K::Expr {
+                break;
+            }
+            self.flow_element(&el, &mut first);
+        }
+        let head = format!(" {} {}", first.text, segments[0].1);
+        out.raw(&head);
+        self.continue_segments(&segments[1..], "", out);
     }
 
     /// `node` on one line, if it was written on one, has no comment and

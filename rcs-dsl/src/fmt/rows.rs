@@ -230,9 +230,46 @@ impl Layout<'_> {
         out.indent = block_indent;
     }
 
+    /// After a line holding a condition's first operand: the other
+    /// operands, as many on a line as fit, each further line starting with
+    /// the operator two levels deeper; then `tail` (if any) on the last
+    /// line, or on one of its own when it does not fit.
+    pub(crate) fn continue_segments(
+        &self,
+        segments: &[(String, String)],
+        tail: &str,
+        out: &mut Out,
+    ) {
+        let block_indent = out.indent;
+        let deeper = block_indent + 2 * INDENT;
+        for (op, text) in segments {
+            let piece = format!("{op} {text}");
+            if out.line_len() + 1 + width(&piece) <= self.max_width {
+                out.text.push(' ');
+                out.text.push_str(&piece);
+            } else {
+                out.newline();
+                out.indent = deeper;
+                out.raw(&piece);
+                out.indent = block_indent;
+            }
+        }
+        if !tail.is_empty() {
+            if out.line_len() + 1 + width(tail) <= self.max_width {
+                out.text.push(' ');
+                out.text.push_str(tail);
+            } else {
+                out.newline();
+                out.indent = deeper;
+                out.raw(tail);
+                out.indent = block_indent;
+            }
+        }
+    }
+
     /// The condition split before each of its loosest boolean operators,
     /// `None` when it has none at its top level.
-    fn segments(&self, expr: &SyntaxNode) -> Option<Vec<(String, String)>> {
+    pub(crate) fn segments(&self, expr: &SyntaxNode) -> Option<Vec<(String, String)>> {
         let elements: Vec<SyntaxElement> = expr
             .children_with_tokens()
             .filter(|e| e.kind() != K::Whitespace)

@@ -83,13 +83,20 @@ fn spacing_around_operators_and_inside_brackets() {
 
 #[test]
 fn a_file_that_does_not_parse_is_refused() {
-    assert!(matches!(format("controller A {", &FmtOptions::default()), Err(FmtError::Syntax(_))));
+    assert!(matches!(
+        format("controller A {", &FmtOptions::default()),
+        Err(FmtError::Syntax(_))
+    ));
 }
 
 #[test]
 fn hostile_input_never_panics_and_round_trips() {
     let deep = "(".repeat(10_000);
-    let nested = format!("controller A {{ command GO plan GO {{ *0 when {}x{} -> Done }} }}", "(".repeat(60), ")".repeat(60));
+    let nested = format!(
+        "controller A {{ command GO plan GO {{ *0 when {}x{} -> Done }} }}",
+        "(".repeat(60),
+        ")".repeat(60)
+    );
     for text in [
         deep.as_str(),
         nested.as_str(),
@@ -107,4 +114,17 @@ fn hostile_input_never_panics_and_round_trips() {
             assert_eq!(format(&out, &FmtOptions::default()).unwrap(), out);
         }
     }
+}
+
+#[test]
+fn a_long_accept_condition_is_broken_like_a_rows() {
+    let text = "controller A {\n    status s: u8 = 0\n    command STOP accept when s != 1 && s != 2 && s != 3 && s != 4\n    plan STOP { *0 when new_command -> Done }\n}\n";
+    let out = fmt_width(text, 50);
+    assert!(
+        out.contains(
+            "    command STOP accept when s != 1 && s != 2\n            && s != 3 && s != 4\n"
+        ),
+        "{out}"
+    );
+    assert_eq!(fmt_width(&out, 50), out);
 }

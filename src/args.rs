@@ -44,6 +44,9 @@ pub(crate) enum Command {
     /// Compare two versions of plan sets (paths or git revisions), by meaning.
     #[command(after_help = DIFF_HELP)]
     Diff(DiffArgs),
+    /// Lay out .rcs files in the one canonical layout (in place, or --check).
+    #[command(after_help = crate::fmt_cmd::FMT_HELP)]
+    Fmt(crate::fmt_cmd::FmtArgs),
     /// Write a static, offline site of the plans: graphs, tables, source, findings.
     #[command(after_help = crate::doc_cmd::DOC_HELP)]
     Doc(crate::doc_cmd::DocArgs),

@@ -15,6 +15,7 @@ mod completions;
 mod console_cmd;
 mod diff_cmd;
 mod doc_cmd;
+mod fmt_cmd;
 mod lsp;
 mod output;
 mod test_cmd;
@@ -35,6 +36,7 @@ fn main() -> ExitCode {
         Command::Test(args) => test_cmd::test(args),
         Command::Diff(args) => diff_cmd::diff(args),
         Command::Doc(args) => doc_cmd::doc(args),
+        Command::Fmt(args) => fmt_cmd::fmt(args),
         Command::Trace(args) => trace_cmd::trace(args),
         Command::Certs(args) => certs_cmd::certs(args),
         #[cfg(feature = "console")]

@@ -12,13 +12,14 @@ mod common;
 use common::{rcsc, scratch, text};
 
 /// Every subcommand the pages and the scripts must know.
-const SUBCOMMANDS: [&str; 12] = [
+const SUBCOMMANDS: [&str; 13] = [
     "check",
     "build",
     "graph",
     "ir",
     "test",
     "diff",
+    "fmt",
     "doc",
     "trace",
     "certs",

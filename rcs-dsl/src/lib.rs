@@ -33,6 +33,7 @@ pub mod diagnostic;
 pub mod diff;
 pub mod error_codes;
 mod expand;
+pub mod fmt;
 pub mod interp;
 pub mod ir;
 pub mod lint;

@@ -66,7 +66,7 @@ mod tests;
 pub use guard::is_generated;
 pub(crate) use guard::safe_relative;
 pub use lock::OutputLock;
-pub use single::{check_file, write_file, write_file_bytes, Inputs};
+pub use single::{check_file, rewrite_source, write_file, write_file_bytes, Inputs};
 
 use crate::{OutputFile, GENERATED};
 use guard::Existing;

@@ -191,3 +191,58 @@ pub fn write_file_bytes(
     report.written.push(path.to_path_buf());
     Ok(report)
 }
+
+/// Rewrite a source file the user named in place (`rcsc fmt`): the one
+/// write that replaces an input on purpose, so it skips the marker and
+/// input checks of [`write_file`] but keeps the rest of its rules — the
+/// folder's lock, a link followed to the file it names, the contents staged
+/// to a temporary beside the file and renamed over it (a failure leaves the
+/// original whole), the file's permissions kept. The file must exist:
+/// this replaces, never creates. Unchanged bytes are not rewritten.
+pub fn rewrite_source(
+    path: &Path,
+    contents: &str,
+    blocked: &mut dyn FnMut(&Path),
+) -> Result<WriteReport, WriteError> {
+    let target = std::fs::canonicalize(path).map_err(|e| io_err(path, e))?;
+    let meta = std::fs::metadata(&target).map_err(|e| io_err(path, e))?;
+    if !meta.is_file() {
+        return Err(WriteError::InTheWay {
+            path: path.display().to_string(),
+            why: "it is not a file",
+        });
+    }
+    let name = target
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    if name.starts_with(super::RESERVED_PREFIX) {
+        return Err(WriteError::Reserved(path.display().to_string()));
+    }
+    let dir = match target.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let _lock = OutputLock::acquire(&dir, blocked)?;
+    let mut report = WriteReport::default();
+    if existing(&target)?.is_some_and(|old| old == contents.as_bytes()) {
+        report.unchanged.push(path.to_path_buf());
+        return Ok(report);
+    }
+    let tmp = dir.join(format!("{TMP_PREFIX}{}-{name}", std::process::id()));
+    let staged = std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&tmp)
+        .and_then(|mut f| {
+            f.write_all(contents.as_bytes())?;
+            f.sync_all()?;
+            std::fs::set_permissions(&tmp, meta.permissions())
+        });
+    if let Err(e) = staged.and_then(|()| std::fs::rename(&tmp, &target)) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(io_err(&target, e));
+    }
+    report.written.push(path.to_path_buf());
+    Ok(report)
+}

@@ -26,6 +26,15 @@ use syntax_error::syntax_error;
 #[grammar = "grammar.pest"]
 struct RcsParser;
 
+/// pest's parse tree of a file [`parse_file`] accepted: the nesting the
+/// lossless syntax tree of `rcsc fmt` ([`crate::fmt`]) is built from, so
+/// that the formatter sees exactly the structure the parser does. `None`
+/// when pest rejects the text (callers run [`parse_file`] first, which
+/// also bounds the nesting before pest runs).
+pub(crate) fn pest_tree(text: &str) -> Option<pest::iterators::Pair<'_, Rule>> {
+    RcsParser::parse(Rule::file, text).ok()?.next()
+}
+
 /// Largest accepted source file.
 pub const MAX_FILE_BYTES: usize = 16 * 1024 * 1024;
 /// Deepest accepted nesting of `(`, `[` and `{`.

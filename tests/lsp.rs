@@ -2,8 +2,8 @@
 //! starts the binary, speaks JSON-RPC with `Content-Length` framing as an
 //! editor does, and checks what comes back — diagnostics as the file is
 //! typed (the right code and range, then cleared by the fix), hover,
-//! definition, references, completion, document symbols, and a clean
-//! shutdown. Nothing here calls the server's handlers directly.
+//! definition, references, completion, document symbols, formatting, and a
+//! clean shutdown. Nothing here calls the server's handlers directly.
 
 mod common;
 
@@ -333,6 +333,38 @@ fn a_client_conversation_over_stdio() {
         .filter_map(|r| r["name"].as_str())
         .collect();
     assert_eq!(rows, ["E0", "E1", "E2"]);
+
+    // Formatting: `rcsc fmt`'s layout as one edit; none once formatted.
+    let messy = HELM.replace("    command GO", "  command   GO");
+    client.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": helm, "version": 3}, "contentChanges": [{"text": messy}]}),
+    );
+    let _ = client.diagnostics(&helm, &mut kept);
+    let edits = client.request(
+        "textDocument/formatting",
+        json!({"textDocument": {"uri": helm}, "options": {"tabSize": 4, "insertSpaces": true}}),
+        &mut kept,
+    );
+    let edits = edits.as_array().expect("edits");
+    assert_eq!(edits.len(), 1, "{edits:?}");
+    let formatted = edits[0]["newText"].as_str().expect("new text");
+    assert!(formatted.contains("\n    command GO\n"), "{formatted}");
+    assert_eq!(
+        edits[0]["range"]["start"],
+        json!({"line": 0, "character": 0})
+    );
+    client.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": helm, "version": 4}, "contentChanges": [{"text": formatted}]}),
+    );
+    let _ = client.diagnostics(&helm, &mut kept);
+    let again = client.request(
+        "textDocument/formatting",
+        json!({"textDocument": {"uri": helm}, "options": {"tabSize": 4, "insertSpaces": true}}),
+        &mut kept,
+    );
+    assert_eq!(again, json!([]), "formatted text needs no edit");
 
     // Shutdown and exit: the server ends cleanly.
     let done = client.request("shutdown", json!(null), &mut kept);

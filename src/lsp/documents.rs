@@ -34,7 +34,7 @@ impl Documents {
     }
 
     /// The text of `path` as the editor has it, else as it is on disk.
-    fn current(&self, path: &Path) -> Option<String> {
+    pub fn current(&self, path: &Path) -> Option<String> {
         self.open
             .get(path)
             .cloned()

@@ -6,7 +6,8 @@
 //! ([`documents`]) and publishes the diagnostics `rcsc check` would print —
 //! same codes, spans, notes and help, secondary labels and witnesses as
 //! related information. Navigation ([`navigate`]) reads the checked IR's
-//! spans: definition, references, hover, document symbols, completion.
+//! spans: definition, references, hover, document symbols, completion;
+//! formatting is `rcsc fmt`'s (rcs-dsl's `fmt`).
 //! Positions are UTF-16, as LSP defaults to ([`position`]).
 //!
 //! The server is synchronous: one message at a time, a check per edit.
@@ -26,7 +27,8 @@ use lsp_types::notification::{
     PublishDiagnostics,
 };
 use lsp_types::request::{
-    Completion, DocumentSymbolRequest, GotoDefinition, HoverRequest, References, Request as _,
+    Completion, DocumentSymbolRequest, Formatting, GotoDefinition, HoverRequest, References,
+    Request as _,
 };
 use lsp_types::{
     CompletionOptions, CompletionResponse, DiagnosticRelatedInformation, DiagnosticSeverity,
@@ -68,6 +70,7 @@ fn capabilities() -> ServerCapabilities {
         references_provider: Some(OneOf::Left(true)),
         document_symbol_provider: Some(OneOf::Left(true)),
         completion_provider: Some(CompletionOptions::default()),
+        document_formatting_provider: Some(OneOf::Left(true)),
         ..ServerCapabilities::default()
     }
 }
@@ -238,6 +241,15 @@ impl Server {
                 });
                 Ok(to_json(&items))
             }
+            Formatting::METHOD => {
+                let p: lsp_types::DocumentFormattingParams = params(r.params)?;
+                let path = uri_path(&p.text_document.uri);
+                let text = self
+                    .docs
+                    .current(&path)
+                    .ok_or_else(|| format!("{} is neither open nor readable", path.display()))?;
+                Ok(to_json(&format_edits(&path, &text)?))
+            }
             other => Err(format!("`{other}` is not a request rcsc lsp answers")),
         }
     }
@@ -254,6 +266,22 @@ impl Server {
         let file = a.file_of(&path)?;
         let offset = LineIndex::new(a.text(file)).offset(at.position);
         f(a, a.ir()?, file, offset)
+    }
+}
+
+/// `rcsc fmt` of `text` as one edit replacing the whole document (none
+/// when it is formatted already; `None` when it does not parse: its
+/// diagnostics say why).
+fn format_edits(path: &Path, text: &str) -> Result<Option<Vec<lsp_types::TextEdit>>, String> {
+    let (options, _) = rcs_dsl::fmt::config::options_for(path)?;
+    match rcs_dsl::fmt::format(text, &options) {
+        Ok(formatted) if formatted == text => Ok(Some(Vec::new())),
+        Ok(formatted) => {
+            let whole = LineIndex::new(text).range(0, text.len());
+            Ok(Some(vec![lsp_types::TextEdit::new(whole, formatted)]))
+        }
+        Err(rcs_dsl::fmt::FmtError::Syntax(_)) => Ok(None),
+        Err(e) => Err(e.to_string()),
     }
 }
 

@@ -12,7 +12,7 @@ mod common;
 use common::{rcsc, scratch, text};
 
 /// Every subcommand the pages and the scripts must know.
-const SUBCOMMANDS: [&str; 13] = [
+const SUBCOMMANDS: [&str; 14] = [
     "check",
     "build",
     "graph",
@@ -24,6 +24,7 @@ const SUBCOMMANDS: [&str; 13] = [
     "trace",
     "certs",
     "console",
+    "lsp",
     "completions",
     "man",
 ];

@@ -124,29 +124,7 @@ impl<T: BufferData + Schema + DeserializeOwned> Import<T> {
     /// Check the sample and write it. `Ok` also for a resend dropped.
     fn apply(&mut self, bytes: &[u8], now: Instant) -> Result<(), BridgeError> {
         let buffer = || self.name.clone();
-        let max = wire::max_len::<T>();
-        if bytes.len() > max {
-            return Err(BridgeError::Oversized {
-                buffer: buffer(),
-                len: bytes.len(),
-                max,
-            });
-        }
-        let (h, value) = wire::decode::<T>(bytes, T::SCHEMA).map_err(|e| match e {
-            wire::WireError::Schema(got) => BridgeError::SchemaMismatch {
-                buffer: buffer(),
-                expected: T::SCHEMA,
-                got,
-            },
-            wire::WireError::Decode(message) => BridgeError::Decode {
-                buffer: buffer(),
-                message,
-            },
-            wire::WireError::Trailing(extra) => BridgeError::TrailingBytes {
-                buffer: buffer(),
-                extra,
-            },
-        })?;
+        let (h, value) = decode_checked::<T>(&self.name, bytes, wire::max_len::<T>(), T::SCHEMA)?;
         if h.writer != self.expected_writer {
             return Err(BridgeError::WrongWriter {
                 buffer: buffer(),
@@ -211,4 +189,38 @@ impl<T: BufferData + Schema + DeserializeOwned> Import<T> {
 /// The check of a buffer whose every value is valid.
 pub(super) fn any_value<T>(_: &T) -> Result<(), &'static str> {
     Ok(())
+}
+
+/// The first checks of every sample taken from the wire, before it is
+/// decoded and after: no longer than `max` (the longest encoding of its
+/// type), the expected `schema`, decodable with nothing left over. Each
+/// refusal names `buffer`.
+pub(super) fn decode_checked<'a, T: serde::de::DeserializeOwned>(
+    buffer: &str,
+    bytes: &'a [u8],
+    max: usize,
+    schema: u64,
+) -> Result<(wire::Header<'a>, T), BridgeError> {
+    if bytes.len() > max {
+        return Err(BridgeError::Oversized {
+            buffer: buffer.to_owned(),
+            len: bytes.len(),
+            max,
+        });
+    }
+    wire::decode::<T>(bytes, schema).map_err(|e| match e {
+        wire::WireError::Schema(got) => BridgeError::SchemaMismatch {
+            buffer: buffer.to_owned(),
+            expected: schema,
+            got,
+        },
+        wire::WireError::Decode(message) => BridgeError::Decode {
+            buffer: buffer.to_owned(),
+            message,
+        },
+        wire::WireError::Trailing(extra) => BridgeError::TrailingBytes {
+            buffer: buffer.to_owned(),
+            extra,
+        },
+    })
 }

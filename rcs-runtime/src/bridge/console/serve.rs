@@ -138,29 +138,12 @@ impl ControlImport {
 
     fn apply(&mut self, bytes: &[u8]) -> Result<(), BridgeError> {
         let buffer = || CONTROL.to_owned();
-        if bytes.len() > CONTROL_MAX_LEN {
-            return Err(BridgeError::Oversized {
-                buffer: buffer(),
-                len: bytes.len(),
-                max: CONTROL_MAX_LEN,
-            });
-        }
-        let (h, control) = wire::decode::<ExecutiveControl>(bytes, ExecutiveControl::SCHEMA)
-            .map_err(|e| match e {
-                wire::WireError::Schema(got) => BridgeError::SchemaMismatch {
-                    buffer: buffer(),
-                    expected: ExecutiveControl::SCHEMA,
-                    got,
-                },
-                wire::WireError::Decode(message) => BridgeError::Decode {
-                    buffer: buffer(),
-                    message,
-                },
-                wire::WireError::Trailing(extra) => BridgeError::TrailingBytes {
-                    buffer: buffer(),
-                    extra,
-                },
-            })?;
+        let (h, control) = crate::bridge::import::decode_checked::<ExecutiveControl>(
+            CONTROL,
+            bytes,
+            CONTROL_MAX_LEN,
+            ExecutiveControl::SCHEMA,
+        )?;
         if h.writer != OPERATOR {
             return Err(BridgeError::WrongWriter {
                 buffer: buffer(),

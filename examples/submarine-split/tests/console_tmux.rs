@@ -22,98 +22,18 @@
 
 use std::net::TcpListener;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 use std::thread::sleep;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 mod common;
 use common::{security_args, Proc};
 
 const DEADLINE: Duration = Duration::from_secs(180);
 
-fn tmux(args: &[&str]) -> Output {
-    match Command::new("tmux").args(args).output() {
-        Ok(out) => out,
-        Err(e) => panic!("tmux {args:?}: {e}"),
-    }
-}
-
-/// A tmux session killed when the test ends, however it ends.
-struct Session(String);
-
-impl Session {
-    fn screen(&self) -> String {
-        String::from_utf8_lossy(&tmux(&["capture-pane", "-p", "-t", &self.0]).stdout).into_owned()
-    }
-
-    fn keys(&self, keys: &[&str]) {
-        let mut args = vec!["send-keys", "-t", &self.0];
-        args.extend_from_slice(keys);
-        assert!(tmux(&args).status.success(), "send-keys {keys:?}");
-    }
-
-    fn type_text(&self, text: &str) {
-        assert!(
-            tmux(&["send-keys", "-t", &self.0, "-l", text])
-                .status
-                .success(),
-            "send-keys -l {text:?}"
-        );
-    }
-
-    /// Poll the screen until `ok` holds; the screen then, or a panic with
-    /// the last screen at the deadline.
-    fn wait_for(&self, what: &str, mut ok: impl FnMut(&str) -> bool) -> String {
-        let start = Instant::now();
-        loop {
-            let screen = self.screen();
-            if ok(&screen) {
-                return screen;
-            }
-            if start.elapsed() > DEADLINE {
-                panic!("waited {DEADLINE:?} for {what}; the screen:\n{screen}");
-            }
-            sleep(Duration::from_millis(200));
-        }
-    }
-}
-
-impl Drop for Session {
-    fn drop(&mut self) {
-        let _ = Command::new("tmux")
-            .args(["kill-session", "-t", &self.0])
-            .output();
-    }
-}
-
-/// The cycle count on the `CPU NAME` line.
-fn cycle(screen: &str, cpu: &str) -> Option<u64> {
-    let line = screen
-        .lines()
-        .find(|l| l.starts_with(&format!("CPU {cpu} |")))?;
-    let rest = &line[line.find("| cycle ")? + "| cycle ".len()..];
-    rest.split_whitespace().next()?.parse().ok()
-}
-
-/// The tree row of `name` (the line whose first cell is `name`, indented).
-fn tree_row<'a>(screen: &'a str, indent: usize, name: &str) -> Option<&'a str> {
-    let cell = format!("│{}{name} ", " ".repeat(indent));
-    screen.lines().find(|l| l.starts_with(&cell))
-}
-
-/// The `stale` cell of a tree row (columns: name, verb, state, status,
-/// error, stale, timing, overruns; each one word).
-fn stale(row: &str) -> Option<u64> {
-    let cells: Vec<&str> = row.trim_matches('│').split_whitespace().collect();
-    cells.get(5)?.parse().ok()
-}
-
-fn tmux_available() -> bool {
-    Command::new("tmux")
-        .arg("-V")
-        .output()
-        .is_ok_and(|o| o.status.success())
-}
+#[path = "../../submarine/tests/tmux/mod.rs"]
+mod tmux;
+use tmux::{cycle, stale, tmux, tmux_available, tree_row, Session};
 
 /// rcsc with the remote console: `RCSC_BIN`, or built here.
 fn rcsc() -> PathBuf {
@@ -167,12 +87,15 @@ fn remote_console_in_tmux_watches_steps_commands_and_sees_a_dead_engine() {
     );
     helm.wait_for("the engine", |l| l == "helm: engine answered");
 
-    let session = Session(format!("rcs-remote-console-test-{}", std::process::id()));
+    let session = Session {
+        name: format!("rcs-remote-console-test-{}", std::process::id()),
+        deadline: DEADLINE,
+    };
     let started = tmux(&[
         "new-session",
         "-d",
         "-s",
-        &session.0,
+        &session.name,
         "-x",
         "170",
         "-y",
@@ -280,7 +203,13 @@ fn remote_console_in_tmux_watches_steps_commands_and_sees_a_dead_engine() {
         Some("console exit status: 0"),
         "{screen}"
     );
-    let alternate = tmux(&["display-message", "-p", "-t", &session.0, "#{alternate_on}"]);
+    let alternate = tmux(&[
+        "display-message",
+        "-p",
+        "-t",
+        &session.name,
+        "#{alternate_on}",
+    ]);
     assert_eq!(String::from_utf8_lossy(&alternate.stdout).trim(), "0");
     helm.assert_running();
 

@@ -10,86 +10,14 @@
 //! on time. Without tmux the test skips with a reason, except under
 //! `CI=true`, where it fails (`.ci/run` installs tmux).
 
-use std::process::{Command, Output};
 use std::thread::sleep;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
+/// How long any one wait may take (the machine may be loaded).
 const DEADLINE: Duration = Duration::from_secs(120);
 
-fn tmux(args: &[&str]) -> Output {
-    match Command::new("tmux").args(args).output() {
-        Ok(out) => out,
-        Err(e) => panic!("tmux {args:?}: {e}"),
-    }
-}
-
-/// A tmux session killed when the test ends, however it ends.
-struct Session(String);
-
-impl Session {
-    fn screen(&self) -> String {
-        String::from_utf8_lossy(&tmux(&["capture-pane", "-p", "-t", &self.0]).stdout).into_owned()
-    }
-
-    fn keys(&self, keys: &[&str]) {
-        let mut args = vec!["send-keys", "-t", &self.0];
-        args.extend_from_slice(keys);
-        assert!(tmux(&args).status.success(), "send-keys {keys:?}");
-    }
-
-    fn type_text(&self, text: &str) {
-        assert!(
-            tmux(&["send-keys", "-t", &self.0, "-l", text])
-                .status
-                .success(),
-            "send-keys -l {text:?}"
-        );
-    }
-
-    /// Poll the screen until `ok` holds; the screen then, or a panic with
-    /// the last screen at the deadline.
-    fn wait_for(&self, what: &str, mut ok: impl FnMut(&str) -> bool) -> String {
-        let start = Instant::now();
-        loop {
-            let screen = self.screen();
-            if ok(&screen) {
-                return screen;
-            }
-            if start.elapsed() > DEADLINE {
-                panic!("waited {DEADLINE:?} for {what}; the screen:\n{screen}");
-            }
-            sleep(Duration::from_millis(200));
-        }
-    }
-}
-
-impl Drop for Session {
-    fn drop(&mut self) {
-        let _ = Command::new("tmux")
-            .args(["kill-session", "-t", &self.0])
-            .output();
-    }
-}
-
-/// The cycle count on the `CPU main` line.
-fn cycle(screen: &str) -> Option<u64> {
-    let line = screen.lines().find(|l| l.starts_with("CPU main |"))?;
-    let rest = &line[line.find("| cycle ")? + "| cycle ".len()..];
-    rest.split_whitespace().next()?.parse().ok()
-}
-
-/// The tree row of `name` (the line whose first cell is `name`, indented).
-fn tree_row<'a>(screen: &'a str, indent: usize, name: &str) -> Option<&'a str> {
-    let cell = format!("│{}{name} ", " ".repeat(indent));
-    screen.lines().find(|l| l.starts_with(&cell))
-}
-
-fn tmux_available() -> bool {
-    Command::new("tmux")
-        .arg("-V")
-        .output()
-        .is_ok_and(|o| o.status.success())
-}
+mod tmux;
+use tmux::{cycle, tmux, tmux_available, tree_row, Session};
 
 #[test]
 fn console_in_tmux_shows_steps_commands_and_quits() {
@@ -100,12 +28,15 @@ fn console_in_tmux_shows_steps_commands_and_quits() {
         println!("skipped: tmux is not installed (apt-get install tmux)");
         return;
     }
-    let session = Session(format!("rcs-console-test-{}", std::process::id()));
+    let session = Session {
+        name: format!("rcs-console-test-{}", std::process::id()),
+        deadline: DEADLINE,
+    };
     let started = tmux(&[
         "new-session",
         "-d",
         "-s",
-        &session.0,
+        &session.name,
         "-x",
         "160",
         "-y",
@@ -121,7 +52,7 @@ fn console_in_tmux_shows_steps_commands_and_quits() {
 
     // The tree: SM, PR under it, TB under PR.
     let screen = session.wait_for("the tree with SM, PR and TB", |s| {
-        cycle(s).is_some()
+        cycle(s, "main").is_some()
             && tree_row(s, 0, "SM").is_some()
             && tree_row(s, 2, "PR").is_some()
             && tree_row(s, 4, "TB").is_some()
@@ -133,7 +64,7 @@ fn console_in_tmux_shows_steps_commands_and_quits() {
     session.wait_for("PAUSED", |s| s.contains("CPU main | PAUSED |"));
     let mut paused_at = None;
     session.wait_for("a settled cycle count", |s| {
-        let now = cycle(s);
+        let now = cycle(s, "main");
         let settled = now.is_some() && now == paused_at;
         paused_at = now;
         sleep(Duration::from_millis(500));
@@ -141,16 +72,16 @@ fn console_in_tmux_shows_steps_commands_and_quits() {
     });
     let before = paused_at.expect("a cycle count");
     session.keys(&["s"]);
-    let screen = session.wait_for("the single step", |s| cycle(s) != Some(before));
+    let screen = session.wait_for("the single step", |s| cycle(s, "main") != Some(before));
     assert_eq!(
-        cycle(&screen),
+        cycle(&screen, "main"),
         Some(before + 1),
         "one step, one cycle:\n{screen}"
     );
     sleep(Duration::from_secs(1));
     let screen = session.screen();
     assert_eq!(
-        cycle(&screen),
+        cycle(&screen, "main"),
         Some(before + 1),
         "still paused after the step:\n{screen}"
     );
@@ -196,7 +127,13 @@ fn console_in_tmux_shows_steps_commands_and_quits() {
         Some("console exit status: 0"),
         "{screen}"
     );
-    let alternate = tmux(&["display-message", "-p", "-t", &session.0, "#{alternate_on}"]);
+    let alternate = tmux(&[
+        "display-message",
+        "-p",
+        "-t",
+        &session.name,
+        "#{alternate_on}",
+    ]);
     assert_eq!(String::from_utf8_lossy(&alternate.stdout).trim(), "0");
     assert!(
         !screen.contains("rcsc console |"),

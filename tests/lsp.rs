@@ -132,7 +132,11 @@ fn uri(path: &Path) -> String {
 
 /// The LSP position (line, UTF-16 column) of the first `needle` in `text`.
 fn position_of(text: &str, needle: &str) -> Value {
-    let at = text.find(needle).expect("needle in text");
+    position_at(text, text.find(needle).expect("needle in text"))
+}
+
+/// The LSP position of byte `at` of `text`.
+fn position_at(text: &str, at: usize) -> Value {
     let line = text[..at].matches('\n').count();
     let col: usize = text[..at]
         .rsplit('\n')
@@ -367,6 +371,275 @@ fn a_client_conversation_over_stdio() {
     assert_eq!(again, json!([]), "formatted text needs no edit");
 
     // Shutdown and exit: the server ends cleanly.
+    let done = client.request("shutdown", json!(null), &mut kept);
+    assert!(done.is_null());
+    client.notify("exit", json!(null));
+    let status = client.child.wait().expect("rcsc lsp exits");
+    assert!(status.success(), "{status}");
+}
+
+const MODULE: &str = "\
+buffer ModuleIo { running: bool, fault: bool, status_word: u16 }
+
+/// An equipment module, one instance per section.
+controller type Module(station: u8) {
+    reads io: ModuleIo
+    command START
+    command ABORT
+    error FAULTED
+    hook io_cmd(word: u16)
+    plan START {
+        E0: *0 when new_command -> S1 { io_cmd(0x000F | ((station as u16) << 8)) }
+        E1: S1 when (io.status_word & 0x006F) == 0x0027 -> Done
+        E2: *2 when io.fault -> Error(FAULTED)
+    }
+    plan ABORT { *0 when new_command -> Done { io_cmd(0x0000) } }
+}
+
+controller INFEED = Module(station: 1) { io: infeed_io }
+controller FILLER = Module(station: 2) { io: filler_io }
+";
+
+const UNIT: &str = "\
+enum PackState { Stopped, Idle, Starting, Execute, Aborting, Aborted }
+
+controller UNIT {
+    subordinates INFEED, FILLER
+    command START
+    command ABORT
+    error MODULE_FAULT
+    error START_TIMEOUT
+    status state: PackState = Idle
+    var cause: error = MODULE_FAULT
+
+    /// Abort both modules, remembering why.
+    jobs abort_all(why: error) { cause = why; state = Aborting; INFEED <- ABORT; FILLER <- ABORT }
+
+    rows on_fault {
+        * except Aborting when INFEED.error_code == FAULTED || FILLER.error_code == FAULTED -> Aborting {
+            abort_all(MODULE_FAULT)
+        }
+    }
+
+    plan START {
+        E0: *0 when new_command -> Starting { state = Starting; INFEED <- START; FILLER <- START }
+        use on_fault
+        E2: Starting when INFEED.done && FILLER.done -> Done { state = Execute }
+        E3: Starting when state_cycles > 500 -> Aborting { abort_all(START_TIMEOUT) }
+        E4: Aborting when INFEED.done && FILLER.done -> Error(cause) { state = Aborted }
+    }
+    plan ABORT {
+        E0: *0 when new_command -> Aborting { abort_all(cause) }
+        use on_fault
+        E2: Aborting when INFEED.done && FILLER.done -> Done { state = Aborted }
+    }
+}
+";
+
+/// The (line, character) of an LSP location's start.
+fn start_of(location: &Value) -> Value {
+    location["range"]["start"].clone()
+}
+
+/// The `n`-th (0-based) occurrence of `needle` in `text`, as a position.
+fn nth_position(text: &str, needle: &str, n: usize) -> Value {
+    let at = text
+        .match_indices(needle)
+        .nth(n)
+        .map(|(i, _)| i)
+        .expect("needle in text");
+    position_at(text, at)
+}
+
+/// LANGUAGE.md §8's constructs through the same client: definition and
+/// references of names that expansion removes (a controller type and its
+/// parameter, a job list, a row block, a subordinate's verb and error code
+/// through an instance, a buffer type's field), hover on a job list, the
+/// quick fixes of a wrong row number and a misspelt name, and semantic
+/// tokens.
+#[test]
+fn section_8_names_navigate_fix_and_colour() {
+    let dir = common::scratch(
+        "lsp_section_8",
+        &[("module.rcs", MODULE), ("unit.rcs", UNIT)],
+    );
+    let dir = dir.canonicalize().expect("scratch folder");
+    let (module, unit) = (uri(&dir.join("module.rcs")), uri(&dir.join("unit.rcs")));
+    let mut kept = Vec::new();
+    let mut client = Client::start();
+    client.request(
+        "initialize",
+        json!({"processId": null, "rootUri": uri(&dir), "capabilities": {}}),
+        &mut kept,
+    );
+    client.notify("initialized", json!({}));
+    client.notify(
+        "textDocument/didOpen",
+        json!({"textDocument": {"uri": unit, "languageId": "rcs", "version": 1, "text": UNIT}}),
+    );
+    let diags = client.diagnostics(&unit, &mut kept);
+    assert!(diags.iter().all(|d| d["severity"] != 1), "clean: {diags:?}");
+
+    // (file, text, where the cursor is; text of the file it must go to,
+    // where the declaration is), every case a name expansion removes or
+    // that resolves through an instance.
+    let (m, u) = ((&module, MODULE), (&unit, UNIT));
+    let cases = [
+        // A job list's call → its declaration; its parameter in its body.
+        (u, "abort_all(MODULE_FAULT)", u, "abort_all(why"),
+        (u, "why;", u, "why: error"),
+        // A subordinate's verb, through the instance, into the type.
+        (u, "START; FILLER", m, "START\n"),
+        // A subordinate's error code compared with its `error_code`.
+        (u, "FAULTED ||", m, "FAULTED\n"),
+        // The instance as a subordinate → the instance; its type → the type.
+        (u, "INFEED, FILLER", m, "INFEED ="),
+        (m, "Module(station: 1", m, "Module(station: u8"),
+        // The type's parameter, used in a row; a buffer type's field.
+        (m, "station as", m, "station: u8"),
+        (m, "fault ->", m, "fault: bool"),
+        // A variant named bare (`state = Starting`) → the enum's variant.
+        (u, "Starting; INFEED", u, "Starting, Execute"),
+    ];
+    for ((from, from_text), at, (to, to_text), decl) in cases {
+        let def = client.request(
+            "textDocument/definition",
+            json!({"textDocument": {"uri": from}, "position": position_of(from_text, at)}),
+            &mut kept,
+        );
+        assert_eq!(def["uri"], to.as_str(), "{at}: {def}");
+        assert_eq!(start_of(&def), position_of(to_text, decl), "{at}: {def}");
+    }
+
+    // The row block: declared once, placed by two plans.
+    let refs = client.request(
+        "textDocument/references",
+        json!({"textDocument": {"uri": unit}, "position": position_of(UNIT, "on_fault {"), "context": {"includeDeclaration": true}}),
+        &mut kept,
+    );
+    assert_eq!(refs.as_array().map(Vec::len), Some(3), "{refs}");
+    let without = client.request(
+        "textDocument/references",
+        json!({"textDocument": {"uri": unit}, "position": position_of(UNIT, "on_fault {"), "context": {"includeDeclaration": false}}),
+        &mut kept,
+    );
+    assert_eq!(without.as_array().map(Vec::len), Some(2), "{without}");
+
+    // Hover on a job list: its line and its doc comment.
+    let hover = client.request(
+        "textDocument/hover",
+        json!({"textDocument": {"uri": unit}, "position": nth_position(UNIT, "abort_all", 2)}),
+        &mut kept,
+    );
+    let text = hover["contents"]["value"].as_str().expect("hover text");
+    assert!(text.contains("jobs abort_all(why: error)"), "{text}");
+    assert!(text.contains("Abort both modules"), "{text}");
+
+    // Quick fixes: a misspelt name (found while lowering) and a row
+    // number (a check, which runs only once lowering succeeded), each
+    // offered for its diagnostic and giving the plan back when applied.
+    let cases = [
+        (
+            "cause = why",
+            "casue = why",
+            "`casue` with `cause`",
+            "unknown_name",
+        ),
+        (
+            "E2: Starting",
+            "E5: Starting",
+            "`E5` with `E2`",
+            "row_number",
+        ),
+    ];
+    for (version, (good, bad, title, code)) in (2..).zip(cases) {
+        let broken = UNIT.replace(good, bad);
+        client.notify(
+            "textDocument/didChange",
+            json!({"textDocument": {"uri": unit, "version": version}, "contentChanges": [{"text": broken}]}),
+        );
+        let diags = client.diagnostics(&unit, &mut kept);
+        let codes: Vec<&str> = diags.iter().filter_map(|d| d["code"].as_str()).collect();
+        assert!(codes.contains(&code), "{codes:?}");
+        let whole =
+            json!({"start": {"line": 0, "character": 0}, "end": {"line": 999, "character": 0}});
+        let actions = client.request(
+            "textDocument/codeAction",
+            json!({"textDocument": {"uri": unit}, "range": whole, "context": {"diagnostics": []}}),
+            &mut kept,
+        );
+        let actions = actions.as_array().expect("actions");
+        assert_eq!(actions.len(), 1, "{actions:?}");
+        let action = &actions[0];
+        assert_eq!(action["kind"], "quickfix", "{action}");
+        assert!(
+            action["title"].as_str().unwrap_or("").contains(title),
+            "{action}"
+        );
+        assert_eq!(action["diagnostics"][0]["code"], code, "{action}");
+        let edits = action["edit"]["changes"][unit.as_str()]
+            .as_array()
+            .expect("edits");
+        assert_eq!(edits.len(), 1, "{edits:?}");
+        let e = &edits[0];
+        let line = e["range"]["start"]["line"].as_u64().expect("line") as usize;
+        let from = e["range"]["start"]["character"].as_u64().expect("col") as usize;
+        let to = e["range"]["end"]["character"].as_u64().expect("col") as usize;
+        let mut lines: Vec<String> = broken.lines().map(str::to_string).collect();
+        lines[line].replace_range(from..to, e["newText"].as_str().expect("text"));
+        assert_eq!(lines.join("\n") + "\n", UNIT, "the fix gives the plan back");
+    }
+
+    // Semantic tokens: the job list's call is a macro, the subordinate a
+    // namespace, the hook a function, a declaration marked so.
+    client.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": unit, "version": 9}, "contentChanges": [{"text": UNIT}]}),
+    );
+    let _ = client.diagnostics(&unit, &mut kept);
+    let found = client.request(
+        "textDocument/semanticTokens/full",
+        json!({"textDocument": {"uri": module}}),
+        &mut kept,
+    );
+    let data: Vec<u64> = found["data"]
+        .as_array()
+        .expect("data")
+        .iter()
+        .filter_map(Value::as_u64)
+        .collect();
+    assert_eq!(data.len() % 5, 0);
+    // Decode to (line, col, len, type, modifiers).
+    let mut tokens = Vec::new();
+    let (mut line, mut col) = (0, 0);
+    for t in data.chunks(5) {
+        if t[0] > 0 {
+            col = 0;
+        }
+        line += t[0];
+        col += t[1];
+        tokens.push((line, col, t[2], t[3], t[4]));
+    }
+    let token_at = |needle: &str, n: usize| {
+        let p = nth_position(MODULE, needle, n);
+        let (l, c) = (
+            p["line"].as_u64().expect("l"),
+            p["character"].as_u64().expect("c"),
+        );
+        tokens
+            .iter()
+            .find(|t| t.0 == l && t.1 == c)
+            .copied()
+            .unwrap_or_else(|| panic!("a token at {needle}: {tokens:?}"))
+    };
+    // Legend order (tokens.rs): 0 namespace … 7 method, 8 parameter, 9 function.
+    let hook_decl = token_at("io_cmd", 0);
+    assert_eq!((hook_decl.2, hook_decl.3, hook_decl.4 & 1), (6, 9, 1));
+    let hook_call = token_at("io_cmd", 1);
+    assert_eq!((hook_call.3, hook_call.4 & 1), (9, 0));
+    assert_eq!(token_at("INFEED", 0).3, 0, "an instance is a controller");
+    assert_eq!(token_at("station as", 0).3, 8, "a type parameter");
+
     let done = client.request("shutdown", json!(null), &mut kept);
     assert!(done.is_null());
     client.notify("exit", json!(null));

@@ -295,6 +295,20 @@ pub struct Diagnostic {
     /// For a finding that something can happen: the concrete inputs of one
     /// cycle that make it happen (also shown as a note).
     pub witness: Option<Witness>,
+    /// A machine-applicable edit that makes the diagnostic go away ("did
+    /// you mean", a row number): what an editor offers as a quick fix.
+    /// Not part of the rendered or JSON output, which say it in the help.
+    #[serde(skip)]
+    pub fix: Option<Fix>,
+}
+
+/// Replace `was` inside `span` by `with`. `was` is kept so that a client
+/// applying the fix to a text that moved on can tell it no longer applies.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Fix {
+    pub span: Span,
+    pub was: String,
+    pub with: String,
 }
 
 /// The inputs of one cycle that make a finding happen, as the language
@@ -379,6 +393,7 @@ impl Diagnostic {
             notes: Vec::new(),
             help: None,
             witness: None,
+            fix: None,
         }
     }
 
@@ -413,6 +428,20 @@ impl Diagnostic {
             message: label.into(),
             primary: false,
         });
+        self
+    }
+
+    /// The quick fix: `was` (a whole word inside the primary span) becomes
+    /// `with`.
+    pub fn with_fix(mut self, was: impl Into<String>, with: impl Into<String>) -> Self {
+        let span = self.labels.first().map(|l| l.span);
+        if let Some(span) = span {
+            self.fix = Some(Fix {
+                span,
+                was: was.into(),
+                with: with.into(),
+            });
+        }
         self
     }
 

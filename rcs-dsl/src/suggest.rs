@@ -90,6 +90,7 @@ impl crate::diagnostic::Diagnostic {
             if let Some(old) = self.help.replace(help(meant)) {
                 self.notes.push(old);
             }
+            return self.with_fix(name, meant);
         }
         self
     }

@@ -11,13 +11,14 @@
 #![cfg(feature = "foxglove")]
 
 mod common;
+mod foxglove_client;
 
-use std::net::{SocketAddr, TcpStream};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use common::{Relay, GO, HOLD};
+use foxglove_client::{connect, next_data, next_json, Client, DEADLINE};
 use rcs_runtime::foxglove::{
     ControllerNames, FoxgloveError, FoxgloveOptions, FoxgloveServer, LiveSystem,
 };
@@ -25,12 +26,7 @@ use rcs_runtime::{
     Executive, ExecutiveConfig, ExecutiveHandle, ExecutiveMonitor, GlobalMemory, Operator, VerbId,
 };
 use serde_json::{json, Value};
-use tungstenite::client::IntoClientRequest;
-use tungstenite::http::HeaderValue;
-use tungstenite::{Message, WebSocket};
-
-/// How long any one wait may last on a loaded machine.
-const DEADLINE: Duration = Duration::from_secs(120);
+use tungstenite::Message;
 
 /// SM → PR → TB on executive `main` (TB finishes GO after 3 cycles), its
 /// monitor attached, and the operator of SM.
@@ -82,88 +78,6 @@ fn serve(
     assert!(server.warning().is_none());
     let (handle, join) = e.spawn().unwrap();
     (server, handle, join)
-}
-
-type Client = WebSocket<TcpStream>;
-
-/// Connect to `addr` offering `subprotocol`.
-fn connect(
-    addr: SocketAddr,
-    subprotocol: &'static str,
-) -> Result<(Client, tungstenite::handshake::client::Response), tungstenite::Error> {
-    let stream = TcpStream::connect(addr).unwrap();
-    stream
-        .set_read_timeout(Some(Duration::from_millis(200)))
-        .unwrap();
-    let mut request = format!("ws://{addr}").into_client_request().unwrap();
-    request.headers_mut().insert(
-        "Sec-WebSocket-Protocol",
-        HeaderValue::from_static(subprotocol),
-    );
-    // The read timeout interrupts a slow handshake: go on until the
-    // deadline.
-    let start = Instant::now();
-    let mut attempt = tungstenite::client(request, stream);
-    loop {
-        match attempt {
-            Ok(done) => return Ok(done),
-            Err(tungstenite::HandshakeError::Failure(e)) => return Err(e),
-            Err(tungstenite::HandshakeError::Interrupted(mid)) => {
-                assert!(
-                    start.elapsed() < DEADLINE,
-                    "the handshake did not finish within {DEADLINE:?}"
-                );
-                attempt = mid.handshake();
-            }
-        }
-    }
-}
-
-/// The next message, waiting up to [`DEADLINE`].
-fn next(ws: &mut Client) -> Message {
-    let start = Instant::now();
-    loop {
-        match ws.read() {
-            Ok(m) => return m,
-            Err(tungstenite::Error::Io(e))
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                ) =>
-            {
-                assert!(start.elapsed() < DEADLINE, "no message within {DEADLINE:?}");
-            }
-            Err(e) => panic!("the connection failed: {e}"),
-        }
-    }
-}
-
-/// The next text message, as JSON (binary ones in between are skipped).
-fn next_json(ws: &mut Client) -> Value {
-    loop {
-        if let Message::Text(t) = next(ws) {
-            return serde_json::from_str(t.as_str()).unwrap();
-        }
-    }
-}
-
-/// The next Message Data frame: subscription id and payload as JSON.
-fn next_data(ws: &mut Client) -> (u32, Value) {
-    loop {
-        match next(ws) {
-            Message::Binary(b) => {
-                assert_eq!(b[0], 0x01, "Message Data's opcode");
-                assert!(b.len() > 13, "a frame without payload");
-                let sub = u32::from_le_bytes(b[1..5].try_into().unwrap());
-                let time_ns = u64::from_le_bytes(b[5..13].try_into().unwrap());
-                let payload: Value = serde_json::from_slice(&b[13..]).unwrap();
-                assert_eq!(payload["time_ns"].as_u64(), Some(time_ns), "{payload}");
-                return (sub, payload);
-            }
-            Message::Text(t) => panic!("unexpected text message: {t}"),
-            _ => {}
-        }
-    }
 }
 
 /// Server Info then Advertise, checked; the advertised channels.

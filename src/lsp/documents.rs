@@ -10,6 +10,7 @@
 //! document's text, then checked as the CLI checks it: same pipeline, same
 //! codes, spans and help.
 
+use std::cell::OnceCell;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -17,6 +18,8 @@ use rcs_dsl::ir::Ir;
 use rcs_dsl::load::{load_folder, PlanSet};
 use rcs_dsl::source::FileId;
 use rcs_dsl::{check, Checked, Options};
+
+use super::symbols::Index;
 
 /// Open documents by path, with their texts.
 #[derive(Default)]
@@ -48,9 +51,16 @@ pub struct Analysis {
     pub checked: Checked,
     /// The absolute path of every file of the set, by `FileId`.
     pub paths: Vec<PathBuf>,
+    /// The names as written, built on the first request that needs them
+    /// (an edit only publishes diagnostics).
+    symbols: OnceCell<Index>,
 }
 
 impl Analysis {
+    pub fn symbols(&self) -> &Index {
+        self.symbols.get_or_init(|| Index::of_set(&self.set))
+    }
+
     /// The IR, also when only stage 3's checks rejected the plans (their
     /// names and spans are whole then).
     pub fn ir(&self) -> Option<&Ir> {
@@ -165,5 +175,6 @@ pub fn analyse(docs: &Documents, file: &Path) -> Analysis {
         set,
         checked,
         paths,
+        symbols: OnceCell::new(),
     }
 }

@@ -14,9 +14,12 @@
 //! Checking a 100-controller plan set takes milliseconds (BENCHMARKS.md),
 //! so there is nothing to cancel.
 
+mod actions;
 mod documents;
 mod navigate;
 mod position;
+mod symbols;
+mod tokens;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -27,15 +30,16 @@ use lsp_types::notification::{
     PublishDiagnostics,
 };
 use lsp_types::request::{
-    Completion, DocumentSymbolRequest, Formatting, GotoDefinition, HoverRequest, References,
-    Request as _,
+    CodeActionRequest, Completion, DocumentSymbolRequest, Formatting, GotoDefinition, HoverRequest,
+    References, Request as _, SemanticTokensFullRequest,
 };
 use lsp_types::{
-    CompletionOptions, CompletionResponse, DiagnosticRelatedInformation, DiagnosticSeverity,
-    DocumentSymbolResponse, GotoDefinitionResponse, Hover, HoverContents, HoverProviderCapability,
-    Location, MarkupContent, MarkupKind, NumberOrString, OneOf, PositionEncodingKind,
-    PublishDiagnosticsParams, ServerCapabilities, TextDocumentPositionParams,
-    TextDocumentSyncCapability, TextDocumentSyncKind, Uri,
+    CodeActionProviderCapability, CompletionOptions, CompletionResponse,
+    DiagnosticRelatedInformation, DiagnosticSeverity, DocumentSymbolResponse,
+    GotoDefinitionResponse, Hover, HoverContents, HoverProviderCapability, Location, MarkupContent,
+    MarkupKind, NumberOrString, OneOf, PositionEncodingKind, PublishDiagnosticsParams,
+    SemanticTokensFullOptions, SemanticTokensOptions, SemanticTokensResult, ServerCapabilities,
+    TextDocumentPositionParams, TextDocumentSyncCapability, TextDocumentSyncKind, Uri,
 };
 use rcs_dsl::source::{FileId, Span};
 use rcs_dsl::{Diagnostic, Severity};
@@ -71,6 +75,16 @@ fn capabilities() -> ServerCapabilities {
         document_symbol_provider: Some(OneOf::Left(true)),
         completion_provider: Some(CompletionOptions::default()),
         document_formatting_provider: Some(OneOf::Left(true)),
+        code_action_provider: Some(CodeActionProviderCapability::Simple(true)),
+        semantic_tokens_provider: Some(
+            SemanticTokensOptions {
+                legend: tokens::legend(),
+                full: Some(SemanticTokensFullOptions::Bool(true)),
+                range: None,
+                ..SemanticTokensOptions::default()
+            }
+            .into(),
+        ),
         ..ServerCapabilities::default()
     }
 }
@@ -177,16 +191,8 @@ impl Server {
         match r.method.as_str() {
             HoverRequest::METHOD => {
                 let p: lsp_types::HoverParams = params(r.params)?;
-                let hover = self.at(&p.text_document_position_params, |a, ir, file, offset| {
-                    let target = navigate::target_at(a, ir, file, offset)?;
-                    let findings = match target {
-                        navigate::Target::Row(ci, pi, ri) => {
-                            let row = ir.controllers[ci].plans[pi].rows[ri].span;
-                            findings_in(a, row)
-                        }
-                        _ => Vec::new(),
-                    };
-                    let text = navigate::hover(ir, target, &findings)?;
+                let hover = self.at(&p.text_document_position_params, |a, file, offset| {
+                    let text = hover_text(a, file, offset)?;
                     Some(Hover {
                         contents: HoverContents::Markup(MarkupContent {
                             kind: MarkupKind::Markdown,
@@ -199,18 +205,17 @@ impl Server {
             }
             GotoDefinition::METHOD => {
                 let p: lsp_types::GotoDefinitionParams = params(r.params)?;
-                let found = self.at(&p.text_document_position_params, |a, ir, file, offset| {
-                    let target = navigate::target_at(a, ir, file, offset)?;
-                    let span = navigate::definition(ir, target)?;
+                let found = self.at(&p.text_document_position_params, |a, file, offset| {
+                    let span = navigate::definition(a, file, offset)?;
                     location(a, span).map(GotoDefinitionResponse::Scalar)
                 });
                 Ok(to_json(&found))
             }
             References::METHOD => {
                 let p: lsp_types::ReferenceParams = params(r.params)?;
-                let found = self.at(&p.text_document_position, |a, ir, file, offset| {
-                    let target = navigate::target_at(a, ir, file, offset)?;
-                    let spans = navigate::references(a, ir, target);
+                let declaration = p.context.include_declaration;
+                let found = self.at(&p.text_document_position, |a, file, offset| {
+                    let spans = navigate::references(a, file, offset, declaration);
                     Some(
                         spans
                             .into_iter()
@@ -234,9 +239,11 @@ impl Server {
             }
             Completion::METHOD => {
                 let p: lsp_types::CompletionParams = params(r.params)?;
-                let items = self.at(&p.text_document_position, |_, ir, file, offset| {
+                let items = self.at(&p.text_document_position, |a, file, offset| {
                     Some(CompletionResponse::Array(navigate::completion(
-                        ir, file, offset,
+                        a.ir()?,
+                        file,
+                        offset,
                     )))
                 });
                 Ok(to_json(&items))
@@ -250,6 +257,26 @@ impl Server {
                     .ok_or_else(|| format!("{} is neither open nor readable", path.display()))?;
                 Ok(to_json(&format_edits(&path, &text)?))
             }
+            CodeActionRequest::METHOD => {
+                let p: lsp_types::CodeActionParams = params(r.params)?;
+                let path = uri_path(&p.text_document.uri);
+                let a = self.analysis(&path);
+                let actions = a.file_of(&path).map(|file| {
+                    let lines = LineIndex::new(a.text(file));
+                    let (from, to) = (lines.offset(p.range.start), lines.offset(p.range.end));
+                    actions::quick_fixes(a, file, from, to)
+                });
+                Ok(to_json(&actions))
+            }
+            SemanticTokensFullRequest::METHOD => {
+                let p: lsp_types::SemanticTokensParams = params(r.params)?;
+                let path = uri_path(&p.text_document.uri);
+                let a = self.analysis(&path);
+                let found = a
+                    .file_of(&path)
+                    .map(|file| SemanticTokensResult::Tokens(tokens::tokens(a, file)));
+                Ok(to_json(&found))
+            }
             other => Err(format!("`{other}` is not a request rcsc lsp answers")),
         }
     }
@@ -259,14 +286,39 @@ impl Server {
     fn at<T>(
         &mut self,
         at: &TextDocumentPositionParams,
-        f: impl FnOnce(&Analysis, &rcs_dsl::ir::Ir, FileId, usize) -> Option<T>,
+        f: impl FnOnce(&Analysis, FileId, usize) -> Option<T>,
     ) -> Option<T> {
         let path = uri_path(&at.text_document.uri);
         let a = self.analysis(&path);
         let file = a.file_of(&path)?;
         let offset = LineIndex::new(a.text(file)).offset(at.position);
-        f(a, a.ir()?, file, offset)
+        f(a, file, offset)
     }
+}
+
+/// The hover at `offset`: the checked IR's account of a controller,
+/// buffer, state or row (with the row's findings), else the declaration
+/// of any other name the index knows.
+fn hover_text(a: &Analysis, file: FileId, offset: usize) -> Option<String> {
+    let from_ir = a.ir().and_then(|ir| {
+        let target = navigate::target_at(a, ir, file, offset)?;
+        let findings = match target {
+            navigate::Target::Row(ci, pi, ri) => {
+                findings_in(a, ir.controllers[ci].plans[pi].rows[ri].span)
+            }
+            _ => Vec::new(),
+        };
+        let named = a.symbols().at(file, offset);
+        // Inside a row, a name other than a state is hovered as itself.
+        if matches!(target, navigate::Target::Row(..)) && named.is_some() {
+            return None;
+        }
+        navigate::hover(ir, target, &findings)
+    });
+    from_ir.or_else(|| {
+        let index = a.symbols();
+        index.at(file, offset).map(|id| index.hover(id))
+    })
 }
 
 /// `rcsc fmt` of `text` as one edit replacing the whole document (none
@@ -307,7 +359,7 @@ fn findings_in(a: &Analysis, row: Span) -> Vec<String> {
         .collect()
 }
 
-fn primary(d: &Diagnostic) -> Option<Span> {
+pub(crate) fn primary(d: &Diagnostic) -> Option<Span> {
     d.labels
         .iter()
         .find(|l| l.primary)
@@ -345,7 +397,7 @@ fn publish(a: &Analysis) -> Vec<Notification> {
         .collect()
 }
 
-fn convert(a: &Analysis, d: &Diagnostic, span: Span) -> lsp_types::Diagnostic {
+pub(crate) fn convert(a: &Analysis, d: &Diagnostic, span: Span) -> lsp_types::Diagnostic {
     let range = LineIndex::new(a.text(span.file)).range(span.start as usize, span.end as usize);
     let mut message = d.message.clone();
     for note in &d.notes {
@@ -422,7 +474,7 @@ fn uri_path(uri: &Uri) -> PathBuf {
 
 /// The `file:` URI of an absolute path, percent-encoding what a URI path
 /// may not hold.
-fn path_uri(path: &Path) -> Option<Uri> {
+pub(crate) fn path_uri(path: &Path) -> Option<Uri> {
     let mut s = String::from("file://");
     for b in path.to_string_lossy().bytes() {
         if b.is_ascii_alphanumeric() || b"/-._~".contains(&b) {

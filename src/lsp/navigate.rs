@@ -1,11 +1,12 @@
 //! What is under the cursor, and what the editor asks of it: definition,
-//! references, hover, document symbols and completion, all read from the
+//! references, hover, document symbols and completion.
+//!
+//! Definition and references of names come from the index of names as
+//! written ([`super::symbols`]: it also knows types, instances, job lists,
+//! row blocks and parameters, which expansion removes); rows, the hover of
+//! controllers, buffers, states and rows, symbols and completion read the
 //! checked IR's spans (rcs-dsl keeps a span for every controller, buffer
 //! declaration, plan, row and each row's `from` and target).
-//!
-//! States are named only in rows, so a state's references are the
-//! whole-word occurrences of its name in the `from` and target spans of its
-//! plan's rows (which also covers `A | B` and `except` lists).
 
 use lsp_types::{CompletionItem, CompletionItemKind, DocumentSymbol, SymbolKind};
 
@@ -47,24 +48,6 @@ pub fn word_at(text: &str, offset: usize) -> Option<(usize, usize)> {
     (start < end).then_some((start, end))
 }
 
-/// Whole-word occurrences of `name` inside `span`.
-fn occurrences(a: &Analysis, span: Span, name: &str) -> Vec<Span> {
-    let text = a.text(span.file);
-    let (start, end) = (span.start as usize, (span.end as usize).min(text.len()));
-    let Some(part) = text.get(start..end) else {
-        return Vec::new();
-    };
-    part.match_indices(name)
-        .filter(|&(i, _)| {
-            let before = part[..i].chars().next_back();
-            let after = part[i + name.len()..].chars().next();
-            let word = |c: Option<char>| c.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_');
-            !word(before) && !word(after)
-        })
-        .map(|(i, _)| Span::new(span.file, start + i, start + i + name.len()))
-        .collect()
-}
-
 /// What is at `offset` of `file`.
 pub fn target_at(a: &Analysis, ir: &Ir, file: FileId, offset: usize) -> Option<Target> {
     let text = a.text(file);
@@ -100,62 +83,37 @@ pub fn target_at(a: &Analysis, ir: &Ir, file: FileId, offset: usize) -> Option<T
     None
 }
 
-/// Where `target` is defined.
-pub fn definition(ir: &Ir, target: Target) -> Option<Span> {
-    match target {
-        Target::Controller(ci) => Some(ir.controllers.get(ci)?.name_span),
-        Target::Buffer(b) => buffer_spans(ir, b).into_iter().next(),
-        Target::State(ci, pi, si) => ir.controllers.get(ci)?.plans.get(pi)?.states.get(si)?.span,
+/// Where the name at `offset` of `file` is declared: any name the index
+/// knows ([`super::symbols`]), else a row's label.
+pub fn definition(a: &Analysis, file: FileId, offset: usize) -> Option<Span> {
+    let index = a.symbols();
+    if let Some(id) = index.at(file, offset) {
+        return Some(index.symbols[id].def);
+    }
+    let ir = a.ir()?;
+    match target_at(a, ir, file, offset)? {
         Target::Row(ci, pi, ri) => {
             let r = ir.controllers.get(ci)?.plans.get(pi)?.rows.get(ri)?;
             Some(r.label_span.unwrap_or(r.span))
         }
+        _ => None,
     }
 }
 
-fn buffer_spans(ir: &Ir, b: usize) -> Vec<Span> {
-    let mut spans: Vec<Span> = ir
-        .controllers
-        .iter()
-        .flat_map(|c| &c.buffer_spans)
-        .filter(|(id, _)| id.index() == b)
-        .map(|(_, s)| *s)
-        .collect();
-    spans.sort_by_key(|s| (s.file.0, s.start));
-    spans.dedup();
-    spans
-}
-
-/// Every place `target` is named, its definition first.
-pub fn references(a: &Analysis, ir: &Ir, target: Target) -> Vec<Span> {
-    let mut spans = Vec::new();
-    match target {
-        Target::Controller(ci) => {
-            spans.extend(definition(ir, target));
-            for c in &ir.controllers {
-                for (k, s) in c.subordinates.iter().enumerate() {
-                    if s.index() == ci {
-                        spans.extend(c.subordinate_spans.get(k));
-                    }
-                }
+/// Every place the name at `offset` is written, its declaration first
+/// (left out unless `declaration`); a row is named only where it is.
+pub fn references(a: &Analysis, file: FileId, offset: usize, declaration: bool) -> Vec<Span> {
+    let index = a.symbols();
+    match index.at(file, offset) {
+        Some(id) => {
+            let mut spans = index.references(id);
+            if !declaration {
+                spans.remove(0);
             }
+            spans
         }
-        Target::Buffer(b) => spans = buffer_spans(ir, b),
-        Target::State(ci, pi, si) => {
-            let Some(p) = ir.controllers.get(ci).and_then(|c| c.plans.get(pi)) else {
-                return spans;
-            };
-            let name = &p.states[si].name;
-            for r in &p.rows {
-                spans.extend(occurrences(a, r.from_span, name));
-                spans.extend(occurrences(a, r.to_span, name));
-            }
-        }
-        Target::Row(..) => spans.extend(definition(ir, target)),
+        None => definition(a, file, offset).into_iter().collect(),
     }
-    let mut seen = std::collections::BTreeSet::new();
-    spans.retain(|s| seen.insert((s.file.0, s.start, s.end)));
-    spans
 }
 
 fn docs(lines: &[String]) -> String {

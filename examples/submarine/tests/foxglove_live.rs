@@ -7,17 +7,18 @@
 //! No timing is asserted: every wait is bounded by a generous deadline.
 
 use std::io::{BufRead, BufReader};
-use std::net::TcpStream;
+use std::net::SocketAddr;
 use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use serde_json::{json, Value};
-use tungstenite::client::IntoClientRequest;
-use tungstenite::http::HeaderValue;
-use tungstenite::{Message, WebSocket};
+use tungstenite::Message;
 
-const DEADLINE: Duration = Duration::from_secs(180);
+#[path = "../../../rcs-runtime/tests/foxglove_client/mod.rs"]
+mod foxglove_client;
+
+use foxglove_client::{connect, data, next, next_json, DEADLINE};
 
 /// The submarine process, killed when the test ends however it ends.
 struct Running(Child);
@@ -26,32 +27,6 @@ impl Drop for Running {
     fn drop(&mut self) {
         let _ = self.0.kill();
         let _ = self.0.wait();
-    }
-}
-
-/// The next message, waiting up to [`DEADLINE`].
-fn next(ws: &mut WebSocket<TcpStream>) -> Message {
-    let start = Instant::now();
-    loop {
-        match ws.read() {
-            Ok(m) => return m,
-            Err(tungstenite::Error::Io(e))
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                ) =>
-            {
-                assert!(start.elapsed() < DEADLINE, "no message within {DEADLINE:?}");
-            }
-            Err(e) => panic!("the connection failed: {e}"),
-        }
-    }
-}
-
-fn next_json(ws: &mut WebSocket<TcpStream>) -> Value {
-    match next(ws) {
-        Message::Text(t) => serde_json::from_str(t.as_str()).unwrap(),
-        other => panic!("expected a text message, got {other:?}"),
     }
 }
 
@@ -86,29 +61,11 @@ fn foxglove_shows_the_submarine_live() {
             break line[at..].split_whitespace().next().unwrap().to_string();
         }
     };
-    let addr = url.trim_start_matches("ws://");
-    let stream = TcpStream::connect(addr).unwrap();
-    stream
-        .set_read_timeout(Some(Duration::from_millis(200)))
-        .unwrap();
-    let mut request = url.as_str().into_client_request().unwrap();
-    request.headers_mut().insert(
-        "Sec-WebSocket-Protocol",
-        HeaderValue::from_static("foxglove.websocket.v1"),
-    );
-    // The read timeout interrupts a slow handshake: go on until the deadline.
-    let start = Instant::now();
-    let mut attempt = tungstenite::client(request, stream);
-    let mut ws = loop {
-        match attempt {
-            Ok((ws, _)) => break ws,
-            Err(tungstenite::HandshakeError::Failure(e)) => panic!("the handshake failed: {e}"),
-            Err(tungstenite::HandshakeError::Interrupted(mid)) => {
-                assert!(start.elapsed() < DEADLINE, "the handshake did not finish");
-                attempt = mid.handshake();
-            }
-        }
-    };
+    let addr: SocketAddr = url
+        .trim_start_matches("ws://")
+        .parse()
+        .expect("the printed address");
+    let (mut ws, _) = connect(addr, "foxglove.websocket.v1").expect("the handshake");
 
     let info = next_json(&mut ws);
     assert_eq!(info["op"], "serverInfo");
@@ -159,8 +116,7 @@ fn foxglove_shows_the_submarine_live() {
         let Message::Binary(b) = next(&mut ws) else {
             continue;
         };
-        let sub = u32::from_le_bytes(b[1..5].try_into().unwrap());
-        let m: Value = serde_json::from_slice(&b[13..]).unwrap();
+        let (sub, m): (u32, Value) = data(&b);
         match sub {
             1 => {
                 assert_eq!(m["controller"], "PR");

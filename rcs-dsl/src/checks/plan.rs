@@ -48,7 +48,8 @@ pub(crate) fn check_row_numbers(c: &Controller, p: &Plan, sink: &mut Sink) {
                         format!("this is row {}", r.position),
                     )
                     .with_note("row numbers are precedence positions, counted from 0")
-                    .with_help(format!("write `E{}`, or drop the label", r.position)),
+                    .with_help(format!("write `E{}`, or drop the label", r.position))
+                    .with_fix(format!("E{n}"), format!("E{}", r.position)),
                 );
             }
         }
@@ -66,7 +67,8 @@ pub(crate) fn check_row_numbers(c: &Controller, p: &Plan, sink: &mut Sink) {
                         format!("this is row {}", r.position),
                     )
                     .with_note("row numbers are precedence positions, counted from 0")
-                    .with_help(format!("write `*{}`, or a plain `*`", r.position)),
+                    .with_help(format!("write `*{}`, or a plain `*`", r.position))
+                    .with_fix(format!("*{n}"), format!("*{}", r.position)),
                 );
             }
         }

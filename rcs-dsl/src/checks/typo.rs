@@ -87,7 +87,8 @@ pub(crate) fn check_state_typos(c: &Controller, p: &Plan, sink: &mut Sink) {
             format!("a new state, and {orphan}"),
         )
         .with_note("a state that really is new needs rows of its own; else `#[allow(state_typo)]`")
-        .with_help(crate::suggest::help(meant));
+        .with_help(crate::suggest::help(meant))
+        .with_fix(state.name.as_str(), meant);
         if let Some(other) = p.states.iter().find(|t| t.name == meant) {
             if let Some(at) = other.span {
                 d = d.with_secondary(at, format!("`{meant}` is used here"));

@@ -79,17 +79,36 @@ pub(crate) fn expand(files: &mut [File], diags: &mut Diagnostics) -> Origins {
     origins
 }
 
+/// Drop a finding identical to one kept before it at the same place
+/// (findings come sorted by place, so the twins are neighbours).
+fn once_each(diags: Vec<Diagnostic>) -> Vec<Diagnostic> {
+    let mut out: Vec<Diagnostic> = Vec::with_capacity(diags.len());
+    for d in diags {
+        let p = d.primary_span();
+        let twin = out
+            .iter()
+            .rev()
+            .take_while(|o| o.primary_span() == p)
+            .any(|o| *o == d);
+        if !twin {
+            out.push(d);
+        }
+    }
+    out
+}
+
 fn inside(inner: Span, outer: Span) -> bool {
     inner.file == outer.file && outer.start <= inner.start && inner.end <= outer.end
 }
 
 /// Show each finding on expanded text once, where it was written: a
-/// finding inside a controller type is reported once for all instances
-/// that have it (naming them), and a finding on a shared row names every
-/// plan and position the row landed at.
+/// finding in a job list is inlined with it at every call, identically,
+/// and kept once; a finding inside a controller type is reported once for
+/// all instances that have it (naming them), and a finding on a shared
+/// row names every plan and position the row landed at.
 pub(crate) fn attribute(diags: Vec<Diagnostic>, origins: &Origins) -> Vec<Diagnostic> {
     if origins.shared.is_empty() && origins.types.iter().all(|t| t.instances.is_empty()) {
-        return diags;
+        return once_each(diags);
     }
     let mut out: Vec<Diagnostic> = Vec::with_capacity(diags.len());
     // (index in `out`, how many were merged into it, the type) per kept finding in a type.
@@ -176,7 +195,7 @@ pub(crate) fn attribute(diags: Vec<Diagnostic>, origins: &Origins) -> Vec<Diagno
         ));
         kept.push(d);
     }
-    kept
+    once_each(kept)
 }
 
 /// Whether a finding's text names `instance`.

@@ -1,0 +1,107 @@
+//! Code actions: the quick fixes the checks attach to their diagnostics
+//! ([`rcs_dsl::diagnostic::Fix`]: "did you mean", a row number that does
+//! not match its position), offered for the diagnostics in the range the
+//! editor asks about.
+//!
+//! A fix names the text it replaces; it is offered only where that text
+//! stands exactly once, as a whole word, inside the diagnostic's span —
+//! so it can never edit something else.
+
+use std::collections::HashMap;
+
+use lsp_types::{CodeAction, CodeActionKind, CodeActionOrCommand, TextEdit, WorkspaceEdit};
+use rcs_dsl::diagnostic::Fix;
+use rcs_dsl::source::{FileId, Span};
+
+use super::documents::Analysis;
+use super::position::LineIndex;
+
+/// Where `fix.was` stands in its span: once, as a whole word.
+pub fn fix_range(text: &str, fix: &Fix) -> Option<(usize, usize)> {
+    let (start, end) = (fix.span.start as usize, fix.span.end as usize);
+    let part = text.get(start..end.min(text.len()))?;
+    let word = |c: Option<char>| c.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_');
+    let mut found = part.match_indices(fix.was.as_str()).filter(|&(i, w)| {
+        !fix.was.is_empty()
+            && !word(part[..i].chars().next_back())
+            && !word(part[i + w.len()..].chars().next())
+    });
+    let (i, w) = found.next()?;
+    if found.next().is_some() {
+        return None;
+    }
+    Some((start + i, start + i + w.len()))
+}
+
+fn overlaps(span: Span, file: FileId, from: usize, to: usize) -> bool {
+    span.file == file && (span.start as usize) <= to && from <= span.end as usize
+}
+
+/// The quick fixes of the diagnostics of `file` that touch bytes
+/// `from..=to`.
+pub fn quick_fixes(a: &Analysis, file: FileId, from: usize, to: usize) -> Vec<CodeActionOrCommand> {
+    let Some(uri) = a.path(file).and_then(super::path_uri) else {
+        return Vec::new();
+    };
+    let text = a.text(file);
+    let lines = LineIndex::new(text);
+    let mut actions = Vec::new();
+    for d in &a.checked.diagnostics {
+        let Some(fix) = &d.fix else { continue };
+        if !overlaps(fix.span, file, from, to) {
+            continue;
+        }
+        let Some((start, end)) = fix_range(text, fix) else {
+            continue;
+        };
+        let range = lines.range(start, end);
+        let edit = WorkspaceEdit {
+            changes: Some(HashMap::from([(
+                uri.clone(),
+                vec![TextEdit::new(range, fix.with.clone())],
+            )])),
+            ..WorkspaceEdit::default()
+        };
+        let Some(span) = super::primary(d) else {
+            continue;
+        };
+        actions.push(CodeActionOrCommand::CodeAction(CodeAction {
+            title: format!("Replace `{}` with `{}`", fix.was, fix.with),
+            kind: Some(CodeActionKind::QUICKFIX),
+            diagnostics: Some(vec![super::convert(a, d, span)]),
+            edit: Some(edit),
+            is_preferred: Some(true),
+            ..CodeAction::default()
+        }));
+    }
+    actions
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fix(text: &str, span: (usize, usize), was: &str) -> Option<(usize, usize)> {
+        let fix = Fix {
+            span: Span::new(FileId(0), span.0, span.1),
+            was: was.into(),
+            with: "x".into(),
+        };
+        fix_range(text, &fix)
+    }
+
+    #[test]
+    fn a_fix_applies_only_to_one_whole_word() {
+        let text = "E1: S1 when ENGNE.done -> Done";
+        assert_eq!(fix(text, (12, 22), "ENGNE"), Some((12, 17)));
+        // Not inside a longer word, not when it stands twice.
+        assert_eq!(fix(text, (0, 30), "S"), None);
+        assert_eq!(fix("a == a", (0, 6), "a"), None);
+        // Labels with a star: the star is not a word character.
+        assert_eq!(fix("*3 when x -> S1", (0, 2), "*3"), Some((0, 2)));
+        assert_eq!(fix("*33 when", (0, 3), "*3"), None);
+        // A span past the end of a changed text: nothing.
+        assert_eq!(fix("short", (2, 40), "or"), None);
+        assert_eq!(fix("short", (0, 5), ""), None);
+    }
+}

@@ -24,14 +24,25 @@ meaning: the result is parsed again and must give the same syntax tree.
 The width comes from the nearest `rcsfmt.toml` in the file's folder or
 above (`max_width = 100`, the default).
 
+Row labels are left as written unless --renumber: then, for each plan set
+under PATH, every label `EN` and numbered don't-care `*N` becomes its row's
+position (rows placed by `use` count), the `fired:` of the set's scenarios
+follow their rows, and the files are formatted. Only the numbers change
+before the layout, and the set must lower to the same plans afterwards. A
+number written on two rows of a plan, or a scenario name the plans a step
+may run number differently, is left as written with a warning (file:line).
+If any file does not parse, nothing is written.
+
 Exit status: 0 all files formatted (or, with --check, already formatted);
 1 with --check when a file would change; 2 when a file does not parse or
-cannot be read or written (that file is left as it was).
+cannot be read or written (that file is left as it was; with --renumber,
+every file).
 
 Examples:
   rcsc fmt plans/                 # rewrite every .rcs file below plans/
   rcsc fmt --check plans/ examples/   # CI: fail, with a diff, if any would change
-  rcsc fmt plans/submarine/propulsion.rcs";
+  rcsc fmt plans/submarine/propulsion.rcs
+  rcsc fmt --renumber plans/figure13      # labels to positions, scenarios too";
 
 #[derive(Args)]
 pub(crate) struct FmtArgs {
@@ -41,6 +52,11 @@ pub(crate) struct FmtArgs {
     /// with 1 if any file would.
     #[arg(long)]
     pub(crate) check: bool,
+    /// Also set every row label `EN` and numbered don't-care `*N` to its
+    /// row's position, and the `fired:` of the plan sets' scenarios with
+    /// them.
+    #[arg(long)]
+    pub(crate) renumber: bool,
     /// When to colour diagnostics.
     #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
     pub(crate) color: ColorChoice,
@@ -50,6 +66,9 @@ pub(crate) struct FmtArgs {
 }
 
 pub(crate) fn fmt(args: FmtArgs) -> ExitCode {
+    if args.renumber {
+        return crate::renumber_cmd::fmt_renumber(&args);
+    }
     let paths = crate::output::default_paths(args.paths.clone());
     let mut files = Vec::new();
     for path in &paths {
@@ -76,37 +95,16 @@ pub(crate) fn fmt(args: FmtArgs) -> ExitCode {
                 continue;
             }
         };
-        let options = match rcs_dsl::fmt::config::options_for(file) {
-            Ok((options, _)) => options,
-            Err(reason) => return fail(reason),
-        };
-        let formatted = match format(&text, &options) {
-            Ok(formatted) => formatted,
-            Err(FmtError::Syntax(diags)) => {
-                let mut sources = rcs_dsl::source::SourceMap::new();
-                sources.add(shown.clone(), text.clone());
-                for d in &diags {
-                    eprint!("{}", render::render(d, &sources, Format::Human { color }));
-                }
-                eprintln!(
-                    "error: {} does not parse; it was not formatted",
-                    render::escape_controls(&shown)
-                );
-                refused += 1;
-                continue;
-            }
-            Err(e @ FmtError::Changed(_)) => {
-                eprintln!("error: {}: {e}", render::escape_controls(&shown));
-                refused += 1;
-                continue;
-            }
+        let Some(formatted) = format_file(file, &text, color) else {
+            refused += 1;
+            continue;
         };
         if formatted == text {
             continue;
         }
         changed += 1;
         if args.check {
-            print!("{}", unified_diff(&shown, &text, &formatted));
+            print!("{}", unified_diff(&shown, &text, &formatted, "formatted"));
             continue;
         }
         let mut blocked = |dir: &Path| {
@@ -139,8 +137,40 @@ pub(crate) fn fmt(args: FmtArgs) -> ExitCode {
     ExitCode::SUCCESS
 }
 
+/// `text` (of `file`) in the canonical layout with the width of the
+/// file's `rcsfmt.toml`; `None`, the reason printed, when it cannot be.
+pub(crate) fn format_file(file: &Path, text: &str, color: bool) -> Option<String> {
+    let shown = rcs_dsl::load::display(file);
+    let options = match rcs_dsl::fmt::config::options_for(file) {
+        Ok((options, _)) => options,
+        Err(reason) => {
+            eprintln!("error: {}", render::escape_controls(&reason));
+            return None;
+        }
+    };
+    match format(text, &options) {
+        Ok(formatted) => Some(formatted),
+        Err(FmtError::Syntax(diags)) => {
+            let mut sources = rcs_dsl::source::SourceMap::new();
+            sources.add(shown.clone(), text.to_string());
+            for d in &diags {
+                eprint!("{}", render::render(d, &sources, Format::Human { color }));
+            }
+            eprintln!(
+                "error: {} does not parse; it was not formatted",
+                render::escape_controls(&shown)
+            );
+            None
+        }
+        Err(e @ FmtError::Changed(_)) => {
+            eprintln!("error: {}: {e}", render::escape_controls(&shown));
+            None
+        }
+    }
+}
+
 impl FmtArgs {
-    fn color(&self) -> bool {
+    pub(crate) fn color(&self) -> bool {
         use std::io::IsTerminal;
         match self.color {
             ColorChoice::Always => true,
@@ -187,10 +217,11 @@ fn collect(path: &Path, files: &mut Vec<PathBuf>) -> Result<(), String> {
 }
 
 /// What `rcsc fmt` would change in one file, as `diff -u` prints it.
-fn unified_diff(path: &str, old: &str, new: &str) -> String {
+/// `done` says what made the new text (`formatted`).
+pub(crate) fn unified_diff(path: &str, old: &str, new: &str, done: &str) -> String {
     similar::TextDiff::from_lines(old, new)
         .unified_diff()
         .context_radius(3)
-        .header(path, &format!("{path} (formatted)"))
+        .header(path, &format!("{path} ({done})"))
         .to_string()
 }

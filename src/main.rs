@@ -18,6 +18,7 @@ mod doc_cmd;
 mod fmt_cmd;
 mod lsp;
 mod output;
+mod renumber_cmd;
 mod test_cmd;
 mod trace_cmd;
 mod witnesses;

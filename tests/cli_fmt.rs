@@ -133,3 +133,115 @@ fn a_missing_path_is_a_usage_error() {
         text(&out.stderr)
     );
 }
+
+/// A plan set whose scenario passes: four rows, labelled.
+const STEPS: &str = "buffer Ev {\n    a: bool,\n    b: bool,\n    c: bool,\n}\n\ncontroller P {\n    reads ev: Ev\n    command RUN\n    plan RUN {\n        \
+    E0: *0 when new_command -> S1\n        E1: S1 when ev.a        -> S2\n        \
+    E2: S2 when ev.b        -> S3\n        E3: S3 when ev.c        -> Done\n    }\n}\n";
+const STEPS_SCENARIO: &str =
+    "controller: P\nsteps:\n  - command: RUN\n    expect: { fired: E0, state: S1 }\n  \
+    - reads: { ev: { a: true } }\n    expect: { fired: E1, state: S2 }   # the first step\n  \
+    - reads: { ev: { b: true } }\n    expect: { fired: E2, state: S3 }\n  \
+    - reads: { ev: { c: true } }\n    expect:\n      fired: E3\n      status: DONE\n";
+/// The line of the first row of P's plan.
+const E1_ROW: &str = "        E1: S1 when ev.a        -> S2\n";
+
+#[test]
+fn renumber_fixes_a_row_inserted_with_a_copied_label_and_the_scenario_after_it() {
+    // A row inserted after E1, its label copied: E2 and E3 move down one.
+    let inserted = STEPS.replace(E1_ROW, &format!("{E1_ROW}        E1: S2 when ev.c -> S1\n"));
+    assert_ne!(inserted, STEPS);
+    let scenario = "p/scenarios/run.scenario.yaml";
+    let dir = scratch(
+        "fmt_renumber",
+        &[("p/p.rcs", &inserted), (scenario, STEPS_SCENARIO)],
+    );
+    let check = rcsc_in(&dir, &["check", "p"]);
+    assert_eq!(check.status.code(), Some(1));
+    assert!(
+        text(&check.stderr).contains("error[row_number]"),
+        "{}",
+        text(&check.stderr)
+    );
+    // `rcsc test` runs plans only the checks reject, but shows why.
+    let test = rcsc_in(&dir, &["test", "p"]);
+    assert!(
+        text(&test.stderr).contains("error[row_number]"),
+        "{}",
+        text(&test.stderr)
+    );
+    // Plain `rcsc fmt` lays the rows out and leaves their labels.
+    let fmt = rcsc_in(&dir, &["fmt", "p"]);
+    assert_eq!(fmt.status.code(), Some(0), "{}", text(&fmt.stderr));
+    let formatted = std::fs::read_to_string(dir.join("p/p.rcs")).unwrap();
+    assert_eq!(formatted.matches("E1: ").count(), 2, "{formatted}");
+
+    let dry = rcsc_in(&dir, &["fmt", "--renumber", "--check", "p"]);
+    assert_eq!(dry.status.code(), Some(1), "{}", text(&dry.stderr));
+    let diff = text(&dry.stdout);
+    assert!(
+        diff.contains("+        E4: S3 when ev.c        -> Done\n"),
+        "{diff}"
+    );
+    assert!(diff.contains("+      fired: E4\n"), "{diff}");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("p/p.rcs")).unwrap(),
+        formatted
+    );
+
+    let out = rcsc_in(&dir, &["fmt", "--renumber", "p"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains("Renumbered p/p.rcs (E1 → E2, E2 → E3, E3 → E4)"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("Updated p/scenarios/run.scenario.yaml (E2 → E3, E3 → E4)"),
+        "{stderr}"
+    );
+    // `E1` is on two rows: the scenario's `fired: E1` is left, and said.
+    assert!(
+        stderr.contains("warning: p/scenarios/run.scenario.yaml:6: `fired: E1`"),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join(scenario)).unwrap(),
+        STEPS_SCENARIO
+            .replace("fired: E2", "fired: E3")
+            .replace("fired: E3\n", "fired: E4\n")
+    );
+    let check = rcsc_in(&dir, &["check", "p"]);
+    assert_eq!(check.status.code(), Some(0), "{}", text(&check.stderr));
+    let test = rcsc_in(&dir, &["test", "p"]);
+    assert_eq!(test.status.code(), Some(0), "{}", text(&test.stderr));
+    assert!(
+        text(&test.stdout).contains("1 passed, 0 failed"),
+        "{}",
+        text(&test.stdout)
+    );
+    // A second run changes nothing.
+    let again = rcsc_in(&dir, &["fmt", "--renumber", "--check", "p"]);
+    assert_eq!(again.status.code(), Some(0), "{}", text(&again.stdout));
+    assert!(again.stdout.is_empty(), "{}", text(&again.stdout));
+}
+
+#[test]
+fn renumber_writes_nothing_when_a_file_does_not_parse() {
+    let inserted = STEPS.replace(E1_ROW, &format!("{E1_ROW}{E1_ROW}"));
+    let dir = scratch(
+        "fmt_renumber_broken",
+        &[("p/p.rcs", &inserted), ("q/q.rcs", BROKEN)],
+    );
+    let out = rcsc_in(&dir, &["fmt", "--renumber", "p", "q"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    let stderr = text(&out.stderr);
+    assert!(stderr.contains("error[syntax]"), "{stderr}");
+    assert!(stderr.contains("no file was written"), "{stderr}");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("p/p.rcs")).unwrap(),
+        inserted
+    );
+    let check = rcsc_in(&dir, &["fmt", "--renumber", "--check", "p", "q"]);
+    assert_eq!(check.status.code(), Some(2), "{}", text(&check.stderr));
+}

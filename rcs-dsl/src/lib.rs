@@ -122,6 +122,18 @@ pub fn lower_unchecked(set: &PlanSet) -> Option<ir::Ir> {
     front(set, &mut Diagnostics::new())
 }
 
+/// [`lower_unchecked`] with the errors that stopped it: the IR without
+/// the checks, or the load, parse, expansion and lowering diagnostics.
+/// For tools that rewrite plans a check rejects (`rcsc fmt --renumber`
+/// fixes `row_number`) and must say why they could not.
+pub fn lower_or_diagnostics(set: &PlanSet) -> Result<ir::Ir, Vec<Diagnostic>> {
+    let mut diags = Diagnostics::new();
+    match front(set, &mut diags) {
+        Some(ir) => Ok(ir),
+        None => Err(diags.into_vec()),
+    }
+}
+
 /// Stages 0–2: the load diagnostics, parsing and lowering.
 fn front(set: &PlanSet, diags: &mut Diagnostics) -> Option<ir::Ir> {
     let mut parsed = parse(set, diags)?;

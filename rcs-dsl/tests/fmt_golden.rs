@@ -5,6 +5,7 @@
 //! the repository round-trips through the lossless tree.
 
 use proptest::prelude::*;
+use rcs_dsl::fmt::meaning::{first_difference, without_places};
 use rcs_dsl::fmt::{format, parse, FmtError, FmtOptions};
 use rcs_dsl::{check, Options, PlanSet};
 use std::path::{Path, PathBuf};
@@ -84,7 +85,7 @@ fn ok_cases() -> Vec<Case> {
 }
 
 /// The IR as `rcsc ir --format json` gives it, with every span (and
-/// row line number) removed.
+/// row line number and the file list) removed.
 fn ir_without_spans(
     name: &str,
     files: &[(String, String)],
@@ -96,30 +97,7 @@ fn ir_without_spans(
         manifest,
     );
     let ir = check(&set, &Options::default()).ir?;
-    let mut value = serde_json::to_value(&ir).unwrap();
-    strip_spans(&mut value);
-    Some(value)
-}
-
-fn strip_spans(v: &mut serde_json::Value) {
-    match v {
-        // A span, whatever its key: a place in the text, not meaning.
-        serde_json::Value::Object(map)
-            if map.len() == 3
-                && ["file", "start", "end"]
-                    .iter()
-                    .all(|k| map.contains_key(*k)) =>
-        {
-            *v = serde_json::Value::Null;
-        }
-        serde_json::Value::Object(map) => {
-            // `line`: a row's line in its file, for people.
-            map.retain(|k, _| k != "line");
-            map.values_mut().for_each(strip_spans);
-        }
-        serde_json::Value::Array(items) => items.iter_mut().for_each(strip_spans),
-        _ => {}
-    }
+    Some(without_places(&ir))
 }
 
 /// Format every file of a case; the same IR, and a second pass changes
@@ -153,34 +131,6 @@ fn formats_faithfully(
         ));
     }
     Ok(())
-}
-
-/// Where two JSON values first differ (a path and both values).
-fn first_difference(a: &serde_json::Value, b: &serde_json::Value, at: String) -> String {
-    use serde_json::Value::*;
-    match (a, b) {
-        (Object(x), Object(y)) => {
-            for (k, v) in x {
-                match y.get(k) {
-                    Some(w) if v != w => return first_difference(v, w, format!("{at}.{k}")),
-                    None => return format!("{at}.{k} missing after"),
-                    _ => {}
-                }
-            }
-            format!(
-                "{at}: keys {:?} added",
-                y.keys().filter(|k| !x.contains_key(*k)).collect::<Vec<_>>()
-            )
-        }
-        (Array(x), Array(y)) if x.len() == y.len() => x
-            .iter()
-            .zip(y)
-            .enumerate()
-            .find(|(_, (v, w))| v != w)
-            .map(|(i, (v, w))| first_difference(v, w, format!("{at}[{i}]")))
-            .unwrap_or_default(),
-        _ => format!("{at}: {a} became {b}"),
-    }
 }
 
 #[test]

@@ -102,6 +102,12 @@ fn home_of(scenario: &Path) -> Option<PathBuf> {
         .map(Path::to_path_buf)
 }
 
+/// The scenario files of a plan set's own `scenarios/` folder, sorted
+/// (what `rcsc test` runs for it when none are named).
+pub fn own_scenarios(set: &PlanSet) -> Result<Vec<PathBuf>, String> {
+    scenarios_in(&set_folder(set).join("scenarios"))
+}
+
 /// The folder a plan set's `scenarios/` sits in.
 pub(super) fn set_folder(set: &PlanSet) -> PathBuf {
     if !set.root.is_empty() {

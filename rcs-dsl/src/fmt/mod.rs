@@ -19,15 +19,23 @@
 //!
 //! The language server reuses [`format`] for formatting requests and the
 //! tree of [`syntax::parse`] for positions and tokens.
+//!
+//! Beside the layout, [`renumber`] (`rcsc fmt --renumber`) rewrites row
+//! labels to positions in a whole plan set and its scenarios, changing
+//! only digits; [`meaning`] is the IR without places that it and the
+//! formatter's tests compare.
 
 pub mod config;
 mod layout;
 mod lexer;
+pub mod meaning;
 mod out;
+pub mod renumber;
 mod rows;
 pub mod syntax;
 
 pub use config::FmtOptions;
+pub use renumber::{renumber, ChangedFile, Relabel, RenumberError, Renumbered, Undecided};
 pub use syntax::{parse, Cst, RcsLanguage, SyntaxElement, SyntaxKind, SyntaxNode, SyntaxToken};
 
 use crate::diagnostic::Diagnostic;

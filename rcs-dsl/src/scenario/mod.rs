@@ -22,6 +22,7 @@ pub use run::{run, run_observed, run_on};
 pub(crate) use script::run_script_observed;
 pub use script::{run_script, ControllerExpect, SystemScript, SystemStep};
 pub use system::{run_system, run_system_on, schedule, state_name, SystemOutcome, SystemScenario};
+pub(crate) use system_read::roots_of;
 pub(crate) use values::{merge, value};
 
 use crate::interp::Value;

@@ -110,15 +110,7 @@ pub(super) fn parse_system(
         .map_err(|e| err(e.location.map_or(1, |l| l.line() as usize), e.message))?;
     let run = run_of(ir, &raw)?;
     let r = SystemResolver { ir, run: &run };
-    let roots: Vec<CtrlId> = run
-        .iter()
-        .copied()
-        .filter(|c| {
-            ir.controller(*c)
-                .supervisor
-                .is_none_or(|s| !run.contains(&s))
-        })
-        .collect();
+    let roots = roots_of(ir, &run);
     let init = raw.initial.unwrap_or_default();
     let mut initial = SysStep {
         line: 1,
@@ -228,6 +220,19 @@ pub(super) fn parse_system(
         initial,
         steps,
     })
+}
+
+/// The controllers of `run` whose supervisor is not in it: those the
+/// scenario commands (`command:` goes to the one root, if one).
+pub(crate) fn roots_of(ir: &Ir, run: &[CtrlId]) -> Vec<CtrlId> {
+    run.iter()
+        .copied()
+        .filter(|c| {
+            ir.controller(*c)
+                .supervisor
+                .is_none_or(|s| !run.contains(&s))
+        })
+        .collect()
 }
 
 /// The controllers of the run, by id order: every one (`system: true`) or

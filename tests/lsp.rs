@@ -436,6 +436,16 @@ controller UNIT {
 }
 ";
 
+const START_SCENARIO: &str = "\
+name: UNIT starts both modules
+controller: UNIT
+steps:
+  - command: START
+    expect: { fired: E0, state: Starting, sent: { INFEED: START, FILLER: START } }
+  - subordinates: { INFEED: DONE, FILLER: DONE }
+    expect: { fired: E2 }
+";
+
 /// The (line, character) of an LSP location's start.
 fn start_of(location: &Value) -> Value {
     location["range"]["start"].clone()
@@ -461,7 +471,11 @@ fn nth_position(text: &str, needle: &str, n: usize) -> Value {
 fn section_8_names_navigate_fix_and_colour() {
     let dir = common::scratch(
         "lsp_section_8",
-        &[("module.rcs", MODULE), ("unit.rcs", UNIT)],
+        &[
+            ("module.rcs", MODULE),
+            ("unit.rcs", UNIT),
+            ("scenarios/start.scenario.yaml", START_SCENARIO),
+        ],
     );
     let dir = dir.canonicalize().expect("scratch folder");
     let (module, unit) = (uri(&dir.join("module.rcs")), uri(&dir.join("unit.rcs")));
@@ -568,9 +582,18 @@ fn section_8_names_navigate_fix_and_colour() {
             json!({"textDocument": {"uri": unit}, "range": whole, "context": {"diagnostics": []}}),
             &mut kept,
         );
-        let actions = actions.as_array().expect("actions");
-        assert_eq!(actions.len(), 1, "{actions:?}");
-        let action = &actions[0];
+        let replacing: Vec<&Value> = actions
+            .as_array()
+            .expect("actions")
+            .iter()
+            .filter(|a| {
+                a["title"]
+                    .as_str()
+                    .is_some_and(|t| t.starts_with("Replace"))
+            })
+            .collect();
+        assert_eq!(replacing.len(), 1, "{actions:?}");
+        let action = replacing[0];
         assert_eq!(action["kind"], "quickfix", "{action}");
         assert!(
             action["title"].as_str().unwrap_or("").contains(title),
@@ -589,6 +612,48 @@ fn section_8_names_navigate_fix_and_colour() {
         lines[line].replace_range(from..to, e["newText"].as_str().expect("text"));
         assert_eq!(lines.join("\n") + "\n", UNIT, "the fix gives the plan back");
     }
+
+    // A row inserted without a label: the three after it are numbered
+    // wrong, and one action renumbers them and the scenario that names one.
+    let inserted = UNIT.replace(
+        "        E2: Starting when INFEED.done",
+        "        Starting when INFEED.error || FILLER.error -> Aborting { abort_all(MODULE_FAULT) }\n        E2: Starting when INFEED.done",
+    );
+    client.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": unit, "version": 8}, "contentChanges": [{"text": inserted}]}),
+    );
+    let diags = client.diagnostics(&unit, &mut kept);
+    let wrong = diags.iter().filter(|d| d["code"] == "row_number").count();
+    assert_eq!(wrong, 3, "{diags:?}");
+    let actions = client.request(
+        "textDocument/codeAction",
+        json!({"textDocument": {"uri": unit}, "range": {"start": {"line": 0, "character": 0}, "end": {"line": 999, "character": 0}}, "context": {"diagnostics": []}}),
+        &mut kept,
+    );
+    let all = actions.as_array().expect("actions");
+    let renumber = all
+        .iter()
+        .find(|a| {
+            a["title"]
+                .as_str()
+                .is_some_and(|t| t.starts_with("Renumber"))
+        })
+        .unwrap_or_else(|| panic!("a renumbering action in {all:?}"));
+    assert_eq!(renumber["diagnostics"].as_array().map(Vec::len), Some(3));
+    let changes = &renumber["edit"]["changes"];
+    let scenario = uri(&dir.join("scenarios/start.scenario.yaml"));
+    let new_unit = changes[unit.as_str()][0]["newText"].as_str().expect("unit");
+    let new_scenario = changes[scenario.as_str()][0]["newText"]
+        .as_str()
+        .expect("the scenario");
+    assert!(
+        new_unit.contains("E3: Starting when INFEED.done"),
+        "{new_unit}"
+    );
+    assert!(new_unit.contains("E5: Aborting when"), "{new_unit}");
+    assert!(new_scenario.contains("fired: E3"), "{new_scenario}");
+    assert!(!new_scenario.contains("fired: E2"), "{new_scenario}");
 
     // Semantic tokens: the job list's call is a macro, the subordinate a
     // namespace, the hook a function, a declaration marked so.

@@ -6,11 +6,16 @@
 //! A fix names the text it replaces; it is offered only where that text
 //! stands exactly once, as a whole word, inside the diagnostic's span —
 //! so it can never edit something else.
+//!
+//! Where a row number is wrong, one more action renumbers the whole plan
+//! set as `rcsc fmt --renumber` does ([`rcs_dsl::fmt::renumber`]): every
+//! label and `*N` to its position, and the `fired:` of the set's
+//! scenarios with them (read from disk), as one workspace edit.
 
 use std::collections::HashMap;
 
 use lsp_types::{CodeAction, CodeActionKind, CodeActionOrCommand, TextEdit, WorkspaceEdit};
-use rcs_dsl::diagnostic::Fix;
+use rcs_dsl::diagnostic::{Code, Fix};
 use rcs_dsl::source::{FileId, Span};
 
 use super::documents::Analysis;
@@ -75,6 +80,68 @@ pub fn quick_fixes(a: &Analysis, file: FileId, from: usize, to: usize) -> Vec<Co
         }));
     }
     actions
+}
+
+/// "Renumber the plan set's rows", when some row number of `file` is
+/// wrong: the edits of `rcsc fmt --renumber` (without its layout), each
+/// changed file replaced whole.
+pub fn renumber(a: &Analysis, file: FileId) -> Option<CodeActionOrCommand> {
+    let wrong: Vec<lsp_types::Diagnostic> = a
+        .checked
+        .diagnostics
+        .iter()
+        .filter(|d| d.code == Code::RowNumber)
+        .filter_map(|d| {
+            let span = super::primary(d)?;
+            (span.file == file).then(|| super::convert(a, d, span))
+        })
+        .collect();
+    if wrong.is_empty() {
+        return None;
+    }
+    let scenarios: Vec<(String, String)> = crate::test_cmd::own_scenarios(&a.set)
+        .ok()?
+        .into_iter()
+        .filter_map(|p| {
+            let text = std::fs::read_to_string(&p).ok()?;
+            Some((p.to_string_lossy().into_owned(), text))
+        })
+        .collect();
+    let done = rcs_dsl::fmt::renumber(&a.set, &scenarios).ok()?;
+    let mut changes: Vec<(lsp_types::Uri, Vec<TextEdit>)> = Vec::new();
+    let old_texts = a
+        .set
+        .rcs_files
+        .iter()
+        .map(|&id| a.set.sources.get(id))
+        .map(|f| (f.path.as_str(), f.text.as_str()))
+        .chain(scenarios.iter().map(|(p, t)| (p.as_str(), t.as_str())));
+    let old_texts: HashMap<&str, &str> = old_texts.collect();
+    for changed in done.rcs_files.iter().chain(&done.scenarios) {
+        let old = old_texts.get(changed.path.as_str())?;
+        let uri = super::path_uri(std::path::Path::new(&changed.path))?;
+        let whole = LineIndex::new(old).range(0, old.len());
+        changes.push((uri, vec![TextEdit::new(whole, changed.text.clone())]));
+    }
+    if changes.is_empty() {
+        return None;
+    }
+    let files = done.rcs_files.len();
+    let scenario_files = done.scenarios.len();
+    Some(CodeActionOrCommand::CodeAction(CodeAction {
+        title: format!(
+            "Renumber every row of the plan set ({files} file{}, {scenario_files} scenario{})",
+            if files == 1 { "" } else { "s" },
+            if scenario_files == 1 { "" } else { "s" },
+        ),
+        kind: Some(CodeActionKind::QUICKFIX),
+        diagnostics: Some(wrong),
+        edit: Some(WorkspaceEdit {
+            changes: Some(changes.into_iter().collect()),
+            ..WorkspaceEdit::default()
+        }),
+        ..CodeAction::default()
+    }))
 }
 
 #[cfg(test)]

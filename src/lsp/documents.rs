@@ -120,13 +120,15 @@ fn place_of(file: &Path) -> Place {
 pub fn analyse(docs: &Documents, file: &Path) -> Analysis {
     let mut files: Vec<(PathBuf, String)> = Vec::new();
     let mut manifest: Option<(PathBuf, String)> = None;
+    let mut root: Option<PathBuf> = None;
     let mut name = file
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "plans".into());
-    if let Place::Folder(root) = place_of(file) {
-        if let Ok(set) = load_folder(&root) {
+    if let Place::Folder(folder) = place_of(file) {
+        if let Ok(set) = load_folder(&folder) {
             name = set.name.clone();
+            root = Some(folder.clone());
             for &id in &set.rcs_files {
                 let path = PathBuf::from(&set.sources.get(id).path);
                 let path = if path.is_absolute() {
@@ -138,7 +140,7 @@ pub fn analyse(docs: &Documents, file: &Path) -> Analysis {
                     files.push((path, text));
                 }
             }
-            let yaml = root.join("rcs.yaml");
+            let yaml = folder.join("rcs.yaml");
             manifest = docs.current(&yaml).map(|t| (yaml, t));
         }
     }
@@ -151,11 +153,15 @@ pub fn analyse(docs: &Documents, file: &Path) -> Analysis {
         .iter()
         .map(|(p, t)| (p.to_string_lossy().into_owned(), t.clone()))
         .collect();
-    let set = PlanSet::from_texts(
+    let mut set = PlanSet::from_texts(
         &name,
         names.iter().map(|(p, t)| (p.as_str(), t.as_str())),
         manifest.as_ref().map(|(_, t)| t.as_str()),
     );
+    // Where the set's `scenarios/` are (and paths are shown from).
+    if let Some(root) = root {
+        set.root = root.to_string_lossy().into_owned();
+    }
     let paths = set
         .sources
         .files()

@@ -264,7 +264,9 @@ impl Server {
                 let actions = a.file_of(&path).map(|file| {
                     let lines = LineIndex::new(a.text(file));
                     let (from, to) = (lines.offset(p.range.start), lines.offset(p.range.end));
-                    actions::quick_fixes(a, file, from, to)
+                    let mut found = actions::quick_fixes(a, file, from, to);
+                    found.extend(actions::renumber(a, file));
+                    found
                 });
                 Ok(to_json(&actions))
             }

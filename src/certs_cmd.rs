@@ -74,11 +74,11 @@ pub(crate) fn certs(args: CertsArgs) -> ExitCode {
             let dir = rcs_dsl::load::display(&args.dir);
             let dir = shown(&dir);
             if made.new_ca {
-                println!("made a development CA in {dir} (keep ca.key off the plant network)");
+                outln!("made a development CA in {dir} (keep ca.key off the plant network)");
             } else {
-                println!("reused the CA in {dir}");
+                outln!("reused the CA in {dir}");
             }
-            println!("certificates for: {}", shown(&names.join(", ")));
+            outln!("certificates for: {}", shown(&names.join(", ")));
             ExitCode::SUCCESS
         }
         Err(e) => fail(e),

@@ -70,7 +70,7 @@ pub(crate) fn console(args: ConsoleArgs) -> ExitCode {
     if args.certs.is_some() || args.insecure || args.trace.is_some() {
         return fail("--certs, --insecure and --trace go with --connect ENDPOINT");
     }
-    print!("{}", summary(&catalog));
+    out!("{}", summary(&catalog));
     eprintln!(
         "note: `rcsc console PATH --connect ENDPOINT --certs DIR` attaches to a running \
          distributed system; `cargo run -p submarine-example -- --console` runs the console \

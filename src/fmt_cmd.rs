@@ -104,7 +104,8 @@ pub(crate) fn fmt(args: FmtArgs) -> ExitCode {
         }
         changed += 1;
         if args.check {
-            print!("{}", unified_diff(&shown, &text, &formatted, "formatted"));
+            crate::output::print_stdout(&unified_diff(&shown, &text, &formatted, "formatted"))
+                .unwrap_or_else(|e| eprintln!("error: cannot write to stdout: {e}"));
             continue;
         }
         let mut blocked = |dir: &Path| {

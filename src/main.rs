@@ -6,6 +6,22 @@
 use clap::Parser;
 use std::process::ExitCode;
 
+/// `print!` for what a command reports on stdout, through
+/// [`output::print_stdout`]: a reader that closed the pipe (`rcsc test |
+/// head`) ends the report, never a panic.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        let _ = $crate::output::print_stdout(&format!($($arg)*));
+    }};
+}
+
+/// `println!` as [`out!`] does `print!`.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        let _ = $crate::output::print_stdout(&format!("{}\n", format_args!($($arg)*)));
+    }};
+}
+
 mod args;
 mod certs_cmd;
 mod commands;

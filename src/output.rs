@@ -149,15 +149,22 @@ pub(crate) fn emit(
             Err(e) => write_failed(&e),
         };
     }
+    match print_stdout(text) {
+        Err(e) => fail(format!("cannot write to stdout: {e}")),
+        Ok(()) => ExitCode::SUCCESS,
+    }
+}
+
+/// Write `text` to stdout. A closed pipe (`rcsc ir | head`, `rcsc fmt
+/// --check | head`) is the reader's choice, not a failure: it is `Ok`, and
+/// never the panic `print!` would make of it.
+pub(crate) fn print_stdout(text: &str) -> std::io::Result<()> {
     let mut stdout = std::io::stdout().lock();
     match stdout
         .write_all(text.as_bytes())
         .and_then(|()| stdout.flush())
     {
-        // A closed pipe (`rcsc ir | head`) is the reader's choice, not a failure.
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-            fail(format!("cannot write to stdout: {e}"))
-        }
-        _ => ExitCode::SUCCESS,
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => other,
     }
 }

@@ -57,7 +57,8 @@ pub(crate) fn fmt_renumber(args: &FmtArgs) -> ExitCode {
     if args.check {
         for r in &rewrites {
             let shown = rcs_dsl::load::display(&r.path);
-            print!("{}", unified_diff(&shown, &r.old, &r.new, "renumbered"));
+            crate::output::print_stdout(&unified_diff(&shown, &r.old, &r.new, "renumbered"))
+                .unwrap_or_else(|e| eprintln!("error: cannot write to stdout: {e}"));
         }
         if rewrites.is_empty() {
             return ExitCode::SUCCESS;

@@ -241,3 +241,51 @@ fn man_out_writes_one_page_per_subcommand_and_keeps_hand_written_files() {
     );
     assert!(!out_dir.join("rcsc.1").exists(), "wrote before refusing");
 }
+
+/// A reader that stops early (`rcsc test plans/ | head -1`) closes the
+/// pipe under a report still being written: the command ends without a
+/// panic (status 101 and a `panicked` line are what `print!` makes of it).
+#[test]
+fn a_closed_stdout_ends_a_report_without_a_panic() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    // 200 unformatted files: their diffs are more than a pipe holds.
+    let files: Vec<(String, String)> = (0..200)
+        .map(|i| {
+            let body = format!(
+                "controller C{i} {{\n  command   GO\n  plan GO {{ *0 when new_command -> Done }}\n}}\n"
+            );
+            (format!("c{i}.rcs"), body)
+        })
+        .collect();
+    let files: Vec<(&str, &str)> = files
+        .iter()
+        .map(|(p, b)| (p.as_str(), b.as_str()))
+        .collect();
+    let unformatted = scratch("closed_stdout", &files);
+    let plans = repo.join("plans");
+    let set = plans.join("bridgeport_io");
+    let cases: [(&str, Vec<&std::ffi::OsStr>); 3] = [
+        ("test", vec!["test".as_ref(), plans.as_os_str()]),
+        (
+            "fmt --check",
+            vec!["fmt".as_ref(), "--check".as_ref(), unformatted.as_os_str()],
+        ),
+        ("ir", vec!["ir".as_ref(), set.as_os_str()]),
+    ];
+    for (name, args) in cases {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_rcsc"))
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("rcsc runs");
+        // Read a byte, then close the pipe.
+        let mut out = child.stdout.take().expect("stdout");
+        let _ = std::io::Read::read(&mut out, &mut [0u8; 1]);
+        drop(out);
+        let output = child.wait_with_output().expect("rcsc ends");
+        let stderr = text(&output.stderr);
+        assert!(!stderr.contains("panicked"), "rcsc {name}: {stderr}");
+        assert_ne!(output.status.code(), Some(101), "rcsc {name}: {stderr}");
+    }
+}

@@ -176,11 +176,11 @@ pub(crate) fn test(args: TestArgs) -> ExitCode {
             match r.failure {
                 None => {
                     passed += 1;
-                    println!("test {} ... ok", shown(&r.path));
+                    outln!("test {} ... ok", shown(&r.path));
                 }
                 Some(report) => {
                     failed += 1;
-                    println!("test {} ... FAILED", shown(&r.path));
+                    outln!("test {} ... FAILED", shown(&r.path));
                     reports.push(report);
                 }
             }
@@ -202,20 +202,20 @@ pub(crate) fn test(args: TestArgs) -> ExitCode {
         }
     }
     if !reports.is_empty() {
-        println!("\nfailures:\n");
+        outln!("\nfailures:\n");
         for r in &reports {
-            println!("{}", shown(&r.to_string()));
+            outln!("{}", shown(&r.to_string()));
         }
     }
     if args.coverage {
-        print!("{}", shown(&coverage_text));
-        println!("rows fired: {hit}/{all}\n");
+        out!("{}", shown(&coverage_text));
+        outln!("rows fired: {hit}/{all}\n");
     }
     status.line(
         "Finished",
         format!("in {:.2}s", start.elapsed().as_secs_f64()),
     );
-    println!("{passed} passed, {failed} failed");
+    outln!("{passed} passed, {failed} failed");
     if failed > 0 {
         ExitCode::from(1)
     } else {

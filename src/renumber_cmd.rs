@@ -178,31 +178,21 @@ fn plan_set(set: &PlanSet, quiet: bool, color: bool) -> Option<Vec<Rewrite>> {
     ok.then_some(out)
 }
 
-/// The set's own scenario files as (path, text); `None`, said why, when
-/// one cannot be read.
+/// The set's own scenario files as (path as shown, text); `None`, said
+/// why, when one cannot be read.
 fn read_scenarios(set: &PlanSet) -> Option<Vec<(String, String)>> {
-    let paths = match crate::test_cmd::own_scenarios(set) {
-        Ok(paths) => paths,
+    match crate::test_cmd::own_scenario_texts(set) {
+        Ok(files) => Some(
+            files
+                .into_iter()
+                .map(|(path, text)| (rcs_dsl::load::display(&path), text))
+                .collect(),
+        ),
         Err(reason) => {
             eprintln!("error: {}", render::escape_controls(&reason));
-            return None;
-        }
-    };
-    let mut out = Vec::new();
-    for path in paths {
-        let shown = rcs_dsl::load::display(&path);
-        match std::fs::read_to_string(&path) {
-            Ok(text) => out.push((shown, text)),
-            Err(e) => {
-                eprintln!(
-                    "error: cannot read {}: {e}",
-                    render::escape_controls(&shown)
-                );
-                return None;
-            }
+            None
         }
     }
-    Some(out)
 }
 
 /// `E1 → E2, E2 → E3`: the numbers changed in one file.

@@ -99,13 +99,11 @@ pub fn renumber(a: &Analysis, file: FileId) -> Option<CodeActionOrCommand> {
     if wrong.is_empty() {
         return None;
     }
-    let scenarios: Vec<(String, String)> = crate::test_cmd::own_scenarios(&a.set)
+    // Every scenario or no action: one left out would keep its old names.
+    let scenarios: Vec<(String, String)> = crate::test_cmd::own_scenario_texts(&a.set)
         .ok()?
         .into_iter()
-        .filter_map(|p| {
-            let text = std::fs::read_to_string(&p).ok()?;
-            Some((p.to_string_lossy().into_owned(), text))
-        })
+        .map(|(path, text)| (path.to_string_lossy().into_owned(), text))
         .collect();
     let done = rcs_dsl::fmt::renumber(&a.set, &scenarios).ok()?;
     let mut changes: Vec<(lsp_types::Uri, Vec<TextEdit>)> = Vec::new();

@@ -302,25 +302,21 @@ impl Server {
 /// buffer, state or row (with the row's findings), else the declaration
 /// of any other name the index knows.
 fn hover_text(a: &Analysis, file: FileId, offset: usize) -> Option<String> {
+    let index = a.symbols();
+    let named = index.at(file, offset);
     let from_ir = a.ir().and_then(|ir| {
         let target = navigate::target_at(a, ir, file, offset)?;
         let findings = match target {
+            // Inside a row, a name other than a state is hovered as itself.
+            navigate::Target::Row(..) if named.is_some() => return None,
             navigate::Target::Row(ci, pi, ri) => {
                 findings_in(a, ir.controllers[ci].plans[pi].rows[ri].span)
             }
             _ => Vec::new(),
         };
-        let named = a.symbols().at(file, offset);
-        // Inside a row, a name other than a state is hovered as itself.
-        if matches!(target, navigate::Target::Row(..)) && named.is_some() {
-            return None;
-        }
         navigate::hover(ir, target, &findings)
     });
-    from_ir.or_else(|| {
-        let index = a.symbols();
-        index.at(file, offset).map(|id| index.hover(id))
-    })
+    from_ir.or_else(|| named.map(|id| index.hover(id)))
 }
 
 /// `rcsc fmt` of `text` as one edit replacing the whole document (none

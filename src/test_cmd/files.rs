@@ -108,6 +108,21 @@ pub fn own_scenarios(set: &PlanSet) -> Result<Vec<PathBuf>, String> {
     scenarios_in(&set_folder(set).join("scenarios"))
 }
 
+/// [`own_scenarios`] with their texts; `Err`, saying which, when one
+/// cannot be read (a renumbering must see every scenario or none).
+pub fn own_scenario_texts(set: &PlanSet) -> Result<Vec<(PathBuf, String)>, String> {
+    own_scenarios(set)?
+        .into_iter()
+        .map(|path| match std::fs::read_to_string(&path) {
+            Ok(text) => Ok((path, text)),
+            Err(e) => Err(format!(
+                "cannot read {}: {e}",
+                rcs_dsl::load::display(&path)
+            )),
+        })
+        .collect()
+}
+
 /// The folder a plan set's `scenarios/` sits in.
 pub(super) fn set_folder(set: &PlanSet) -> PathBuf {
     if !set.root.is_empty() {

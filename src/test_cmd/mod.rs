@@ -17,7 +17,7 @@ mod run;
 mod system;
 
 pub use coverage::{coverage, scenario_counts};
-pub use files::{assign, load, own_scenarios, targets};
+pub use files::{assign, load, own_scenario_texts, targets};
 pub use recording::Recording;
 pub use run::{run_set, Fired};
 

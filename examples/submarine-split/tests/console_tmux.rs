@@ -191,26 +191,14 @@ fn remote_console_in_tmux_watches_steps_commands_and_sees_a_dead_engine() {
     common::watchdog_fired(&mut helm);
 
     // 5. Quit: the shell is back, off the alternate screen, exit status 0.
-    session.keys(&["q"]);
-    let exited = |s: &str| {
-        s.lines()
-            .find(|l| l.starts_with("console exit status: "))
-            .map(str::to_owned)
-    };
-    let screen = session.wait_for("the shell", |s| exited(s).is_some());
+    let quit = session.quit();
     assert_eq!(
-        exited(&screen).as_deref(),
+        quit.exit_line.as_deref(),
         Some("console exit status: 0"),
-        "{screen}"
+        "{}",
+        quit.screen
     );
-    let alternate = tmux(&[
-        "display-message",
-        "-p",
-        "-t",
-        &session.name,
-        "#{alternate_on}",
-    ]);
-    assert_eq!(String::from_utf8_lossy(&alternate.stdout).trim(), "0");
+    assert_eq!(quit.alternate_on, "0");
     helm.assert_running();
 
     // 6. The recording: every controller, SM on TRANSIT (verb 1).

@@ -113,28 +113,14 @@ fn console_in_tmux_shows_steps_commands_and_quits() {
     println!("after SM <- TRANSIT(15):\n{screen}");
 
     // Quit: the shell is back, off the alternate screen, exit status 0.
-    session.keys(&["q"]);
-    // The typed line holds `status: $?`; the line the shell prints starts
-    // with the words.
-    let exited = |s: &str| {
-        s.lines()
-            .find(|l| l.starts_with("console exit status: "))
-            .map(str::to_owned)
-    };
-    let screen = session.wait_for("the shell", |s| exited(s).is_some());
+    let quit = session.quit();
+    let screen = quit.screen;
     assert_eq!(
-        exited(&screen).as_deref(),
+        quit.exit_line.as_deref(),
         Some("console exit status: 0"),
         "{screen}"
     );
-    let alternate = tmux(&[
-        "display-message",
-        "-p",
-        "-t",
-        &session.name,
-        "#{alternate_on}",
-    ]);
-    assert_eq!(String::from_utf8_lossy(&alternate.stdout).trim(), "0");
+    assert_eq!(quit.alternate_on, "0");
     assert!(
         !screen.contains("rcsc console |"),
         "the console's screen is gone:\n{screen}"

@@ -16,7 +16,6 @@ use super::{Index, Kind, SymbolId};
 /// for a shared block the plans that place it.
 struct At<'s> {
     body: &'s Body,
-    /// The body's index among the scopes' bodies.
     verbs: Vec<String>,
     job_list: Option<String>,
     /// The state tables a state name is looked up in (one plan's, or every
@@ -171,12 +170,7 @@ impl<'s> Resolver<'s> {
                 .map(|(i, _)| i)
                 .collect()
         };
-        let plain = At {
-            body,
-            verbs: Vec::new(),
-            job_list: None,
-            states: Vec::new(),
-        };
+        let plain = At::of(body);
         for e in &c.entries {
             match &e.kind {
                 EntryKind::Subordinates(names) => {
@@ -204,7 +198,7 @@ impl<'s> Resolver<'s> {
                     if let Some(a) = accept {
                         let at = At {
                             verbs: vec![name.text.to_string()],
-                            ..plain.clone_empty()
+                            ..At::of(body)
                         };
                         self.expr(&at, &a.cond);
                     }
@@ -232,7 +226,7 @@ impl<'s> Resolver<'s> {
                     j.params.iter().for_each(|p| self.ty(&p.ty));
                     let at = At {
                         job_list: Some(j.name.text.to_string()),
-                        ..plain.clone_empty()
+                        ..At::of(body)
                     };
                     j.jobs.iter().for_each(|job| self.job(&at, job));
                 }
@@ -242,7 +236,7 @@ impl<'s> Resolver<'s> {
                             .into_iter()
                             .filter_map(|p| body.states.get(p))
                             .collect(),
-                        ..plain.clone_empty()
+                        ..At::of(body)
                     };
                     for row in &block.rows {
                         self.row(&at, row);
@@ -260,7 +254,7 @@ impl<'s> Resolver<'s> {
                     let at = At {
                         verbs: verbs.iter().map(|v| v.text.to_string()).collect(),
                         states: body.states.get(plan_ix).into_iter().collect(),
-                        ..plain.clone_empty()
+                        ..At::of(body)
                     };
                     for row in &p.rows {
                         self.row(&at, row);
@@ -493,9 +487,10 @@ impl<'s> Resolver<'s> {
 }
 
 impl<'s> At<'s> {
-    fn clone_empty(&self) -> At<'s> {
+    /// In `body`, outside any plan, accept condition or job list.
+    fn of(body: &'s Body) -> At<'s> {
         At {
-            body: self.body,
+            body,
             verbs: Vec::new(),
             job_list: None,
             states: Vec::new(),

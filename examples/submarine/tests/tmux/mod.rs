@@ -64,6 +64,38 @@ impl Session {
     }
 }
 
+/// What the terminal shows once the console was quit with `q`.
+pub struct Quit {
+    /// The shell's screen.
+    pub screen: String,
+    /// The line the shell printed, `console exit status: N`.
+    pub exit_line: Option<String>,
+    /// tmux's `#{alternate_on}`: `0` once the console left the alternate
+    /// screen.
+    pub alternate_on: String,
+}
+
+impl Session {
+    /// Press `q` and wait for the shell's `console exit status: N` line
+    /// (the console runs as `…; echo "console exit status: $?"`; the typed
+    /// line holds `status: $?`, the printed one starts with the words).
+    pub fn quit(&self) -> Quit {
+        self.keys(&["q"]);
+        let exited = |s: &str| {
+            s.lines()
+                .find(|l| l.starts_with("console exit status: "))
+                .map(str::to_owned)
+        };
+        let screen = self.wait_for("the shell", |s| exited(s).is_some());
+        let alternate = tmux(&["display-message", "-p", "-t", &self.name, "#{alternate_on}"]);
+        Quit {
+            exit_line: exited(&screen),
+            screen,
+            alternate_on: String::from_utf8_lossy(&alternate.stdout).trim().to_owned(),
+        }
+    }
+}
+
 impl Drop for Session {
     fn drop(&mut self) {
         let _ = Command::new("tmux")

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Equivalent state machines for the build-cost comparison of issue 30.
 
-generate.py OUT N [--rcsc PATH]
+generate.py OUT N [--rcsc PATH] [--build-opt LEVEL]
 
 writes three crates under OUT, each holding N copies of one machine of
 5 states and 10 rows (rcsc counts its entry row among the 10; the others
@@ -17,6 +17,10 @@ The machine: events 1..3; TABLE lists (from, event, to, add). An event no
 row of the current state takes leaves the machine where it is. `count`
 adds `add` on every transition; the checksum is the sum over machines of
 state_number * 1000 + count after the sequence.
+
+All three crates get the same `[profile.release.build-override]
+opt-level = LEVEL` (default 1; 0 leaves cargo's unoptimised default), so
+that rcsc's build script and the others' proc macros run alike.
 """
 
 import os
@@ -56,6 +60,15 @@ def expected(n):
     return total
 
 
+# Build scripts and proc macros run in cargo's build-override profile, which
+# is unoptimised by default: rcsc's build.rs (rcs-codegen) and smlang's and
+# statig's proc macros alike. The bench gives all three crates the same
+# optimised profile (what rcs-codegen's docs recommend), so that none pays
+# for an unoptimised code generator and the comparison stays fair. Their
+# dependencies are built once; the timed rebuild does not compile them.
+BUILD_OVERRIDE = "\n[profile.release.build-override]\nopt-level = %d\n"
+
+
 def write(path, text):
     os.makedirs(os.path.dirname(path), exist_ok=True)
     with open(path, "w") as f:
@@ -67,7 +80,7 @@ def events_rs(n):
     return "pub const EVENTS: [&[u8]; %d] = [\n%s,\n];\n" % (n, rows)
 
 
-def rcsc_crate(out, n, rcsc):
+def rcsc_crate(out, n, rcsc, build_override):
     plans = []
     for i in range(n):
         rows = ["        *0 when new_command -> S1"]
@@ -82,7 +95,8 @@ def rcsc_crate(out, n, rcsc):
     write(os.path.join(out, "Cargo.toml"),
           "[package]\nname = \"machines-rcsc\"\nversion = \"0.1.0\"\nedition = \"2021\"\n\n"
           "[dependencies]\nrcs-runtime = { path = \"%s/rcs-runtime\" }\n\n"
-          "[build-dependencies]\nrcs-codegen = { path = \"%s/rcs-codegen\" }\n\n[workspace]\n" % (rcsc, rcsc))
+          "[build-dependencies]\nrcs-codegen = { path = \"%s/rcs-codegen\" }\n\n[workspace]\n%s"
+          % (rcsc, rcsc, build_override))
     write(os.path.join(out, "build.rs"),
           "fn main() -> Result<(), Box<dyn std::error::Error>> {\n"
           "    rcs_codegen::Config::new().graphs(false).compile(\"plans/machines\")?;\n    Ok(())\n}\n")
@@ -106,12 +120,12 @@ def rcsc_crate(out, n, rcsc):
     write(os.path.join(out, "src/events.rs"), events_rs(n))
 
 
-def library_crate(out, n, library, version, mods):
+def library_crate(out, n, library, version, mods, build_override):
     """A crate of machine modules `m<i>` (each with `run(events) -> u64`)
     over one state-machine library, its main summing their checksums."""
     write(os.path.join(out, "Cargo.toml"),
           "[package]\nname = \"machines-%s\"\nversion = \"0.1.0\"\nedition = \"2021\"\n\n"
-          "[dependencies]\n%s = \"%s\"\n\n[workspace]\n" % (library, library, version))
+          "[dependencies]\n%s = \"%s\"\n\n[workspace]\n%s" % (library, library, version, build_override))
     runs = "\n".join("    sum += m%d::run(EVENTS[%d]);" % (i, i) for i in range(n))
     write(os.path.join(out, "src/main.rs"),
           "mod events;\nuse events::EVENTS;\n%s\nfn main() {\n    let mut sum = 0u64;\n%s\n    println!(\"checksum {sum}\");\n}\n"
@@ -119,7 +133,7 @@ def library_crate(out, n, library, version, mods):
     write(os.path.join(out, "src/events.rs"), events_rs(n))
 
 
-def smlang_crate(out, n):
+def smlang_crate(out, n, build_override):
     mods = []
     for i in range(n):
         trans = ",\n".join(
@@ -136,10 +150,10 @@ def smlang_crate(out, n):
             "            let _ = sm.process_event(ev);\n        }\n"
             "        let s = match sm.state() { States::S1 => 1, States::S2 => 2, States::S3 => 3, States::S4 => 4, States::S5 => 5 };\n"
             "        s * 1000 + u64::from(sm.context().count)\n    }\n}\n" % (i, trans, acts))
-    library_crate(out, n, "smlang", "0.8", mods)
+    library_crate(out, n, "smlang", "0.8", mods, build_override)
 
 
-def statig_crate(out, n):
+def statig_crate(out, n, build_override):
     mods = []
     for i in range(n):
         arms = []
@@ -157,7 +171,7 @@ def statig_crate(out, n):
             "        for e in events { sm.handle(e); }\n"
             "        let s = match sm.state() { State::S1 {} => 1, State::S2 {} => 2, State::S3 {} => 3, State::S4 {} => 4, State::S5 {} => 5 };\n"
             "        s * 1000 + u64::from(sm.count)\n    }\n}\n" % (i, "".join(arms)))
-    library_crate(out, n, "statig", "0.4", mods)
+    library_crate(out, n, "statig", "0.4", mods, build_override)
 
 
 def main():
@@ -167,9 +181,11 @@ def main():
     out, n = args[0], int(args[1])
     rcsc = os.path.abspath(args[args.index("--rcsc") + 1]) if "--rcsc" in args else \
         os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
-    rcsc_crate(os.path.join(out, "rcsc"), n, rcsc)
-    smlang_crate(os.path.join(out, "smlang"), n)
-    statig_crate(os.path.join(out, "statig"), n)
+    level = int(args[args.index("--build-opt") + 1]) if "--build-opt" in args else 1
+    build_override = "" if level == 0 else BUILD_OVERRIDE % level
+    rcsc_crate(os.path.join(out, "rcsc"), n, rcsc, build_override)
+    smlang_crate(os.path.join(out, "smlang"), n, build_override)
+    statig_crate(os.path.join(out, "statig"), n, build_override)
     print("expected checksum %d" % expected(n))
 
 

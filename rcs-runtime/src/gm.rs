@@ -280,7 +280,9 @@ fn new_cell<T: BufferData>() -> AnyCell {
     fresh_cell::<T>()
 }
 
-/// A new cell holding `T::default()`, never written.
+/// A new cell holding `T::default()`, never written. Out of line: one copy
+/// per buffer type serves the declaration and every stand-in.
+#[inline(never)]
 fn fresh_cell<T: BufferData>() -> Arc<Cell<T>> {
     Arc::new(Cell::<T>::new((T::default(), 0)))
 }
@@ -318,8 +320,17 @@ fn typed_cell<T: BufferData>(cell: AnyCell, name: &str) -> Result<Arc<Cell<T>>, 
 pub(crate) fn cell_or_stand_in<T: BufferData>(cell: AnyCell) -> Arc<Cell<T>> {
     match cell.downcast::<Cell<T>>() {
         Ok(cell) => cell,
-        Err(_) => fresh_cell(),
+        Err(other) => stand_in(other),
     }
+}
+
+/// The cold end of [`cell_or_stand_in`]: drop the cell of another type
+/// (never met: the cores check the type) and make a fresh one.
+#[cold]
+#[inline(never)]
+fn stand_in<T: BufferData>(other: AnyCell) -> Arc<Cell<T>> {
+    drop(other);
+    fresh_cell()
 }
 
 /// The single writer of one buffer. Not `Clone`; `write` takes `&mut self`,
@@ -361,6 +372,46 @@ impl<T: BufferData> Writer<T> {
 }
 
 impl<T> fmt::Debug for Writer<T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Writer").field("name", &self.name).finish()
+    }
+}
+
+/// The single writer of one buffer with its type erased: the operator
+/// keeps a root's command writer so (one non-generic operator core for
+/// every command type) and writes through it with the type it was made
+/// for.
+pub(crate) struct ErasedWriter {
+    writer: Box<dyn Any + Send>,
+    name: Arc<str>,
+}
+
+impl ErasedWriter {
+    /// `writer`, its type erased.
+    pub(crate) fn new<T: BufferData>(writer: Writer<T>) -> Self {
+        let name = Arc::clone(&writer.name);
+        Self {
+            writer: Box::new(writer),
+            name,
+        }
+    }
+
+    /// The writer of a cell [`GlobalMemory::handle_or_stand_in`] gave, as a
+    /// `T` buffer's.
+    pub(crate) fn of<T: BufferData>(parts: (AnyCell, Arc<str>)) -> Self {
+        Self::new(Writer::<T>::from_parts(parts))
+    }
+
+    /// Publish `value` as [`Writer::write`] does, if this is the writer of
+    /// a `T` buffer (`None`, nothing written, otherwise).
+    #[inline]
+    pub(crate) fn write<T: BufferData>(&mut self, value: T, cycle: u64) -> Option<u64> {
+        let writer = self.writer.downcast_mut::<Writer<T>>()?;
+        Some(writer.write(value, cycle))
+    }
+}
+
+impl fmt::Debug for ErasedWriter {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("Writer").field("name", &self.name).finish()
     }

@@ -266,6 +266,21 @@ impl Bookkeeping {
             self.new_command = false;
             return NewCommand::No;
         }
+        self.start_command(serial, epoch, verb, has_plan)
+    }
+
+    /// The rest of step 3 when the command is new. Out of line: it runs
+    /// once per command, not per cycle, and inlined it was most of every
+    /// generated controller's cycle code (issue 30).
+    #[cold]
+    #[inline(never)]
+    fn start_command(
+        &mut self,
+        serial: u32,
+        epoch: u32,
+        verb: VerbId,
+        has_plan: bool,
+    ) -> NewCommand {
         self.before = Before {
             echo_serial: self.echo_serial,
             echo_epoch: self.echo_epoch,
@@ -298,7 +313,8 @@ impl Bookkeeping {
         self.state_cycles = 0;
         self.plan_cycles = 0;
         self.error = ErrorCode::NONE;
-        self.started_at = Some(tick.now);
+        // `now` is this cycle's start (`begin_cycle_raw` set it).
+        self.started_at = self.now;
         if has_plan {
             self.status = Status::EXECUTING;
             self.running = true;

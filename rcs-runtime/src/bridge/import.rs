@@ -25,7 +25,7 @@ use serde::de::DeserializeOwned;
 use zenoh::bytes::ZBytes;
 
 use super::{wire, BridgeError, Shared};
-use crate::gm::{BufferData, Writer};
+use crate::gm::{BufferData, ErasedWriter, Writer};
 use crate::schema::Schema;
 
 /// A range check of an imported value: `Err(what)` names the field out of
@@ -37,7 +37,7 @@ pub type Check<T> = fn(&T) -> Result<(), &'static str>;
 /// command writer shared with the local operator.
 pub(super) enum Sink<T> {
     Own(Writer<T>),
-    Shared(Arc<Mutex<Writer<T>>>),
+    Shared(Arc<Mutex<ErasedWriter>>),
 }
 
 impl<T: BufferData> Sink<T> {
@@ -47,6 +47,8 @@ impl<T: BufferData> Sink<T> {
                 w.write(value, cycle);
             }
             Sink::Shared(w) => {
+                // The operator's writer holds this buffer's type (the
+                // bridge takes it for the same `CommandBuffer<C>`).
                 w.lock()
                     .unwrap_or_else(|p| p.into_inner())
                     .write(value, cycle);

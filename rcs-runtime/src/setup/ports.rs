@@ -14,11 +14,11 @@ use std::sync::Arc;
 
 use crate::error::SetupError;
 use crate::gm::{
-    command_buffer_name, status_buffer_name, AnyCell, BufferData, GlobalMemory, Reader, TypeKey,
-    Writer,
+    command_buffer_name, status_buffer_name, AnyCell, BufferData, ErasedWriter, GlobalMemory,
+    Reader, TypeKey, Writer,
 };
 use crate::handshake::{Command, CommandBuffer, StatusBuffer, Subordinate};
-use crate::operator::Operator;
+use crate::operator::{Operator, OperatorCore};
 
 /// Global Memory being connected to, and the errors met so far.
 #[derive(Debug, Clone)]
@@ -95,8 +95,11 @@ impl Ports {
     /// The operator of root controller `root`: as a
     /// [`subordinate`](Self::subordinate), for the human at the top.
     pub fn operator<C: Command>(&mut self, root: &str) -> Operator<C> {
-        let (command, status) = self.supervise(root, TypeKey::of::<CommandBuffer<C>>());
-        Operator::from_parts((Writer::from_parts(command), status))
+        Operator::from_core(self.operator_core(
+            root,
+            TypeKey::of::<CommandBuffer<C>>(),
+            ErasedWriter::of::<CommandBuffer<C>>,
+        ))
     }
 
     /// `Ok` if every step succeeded; else the one error, or all of them
@@ -124,6 +127,18 @@ impl Ports {
 
     fn command_handle(&mut self, ctrl: &str, key: TypeKey) -> (AnyCell, Arc<str>) {
         self.handle(&command_buffer_name(ctrl), key, false)
+    }
+
+    /// The core of [`operator`](Self::operator): all but the typed writer,
+    /// which `erase` makes from the command buffer's cell.
+    fn operator_core(
+        &mut self,
+        root: &str,
+        command: TypeKey,
+        erase: fn((AnyCell, Arc<str>)) -> ErasedWriter,
+    ) -> OperatorCore {
+        let (command, status) = self.supervise(root, command);
+        OperatorCore::new(erase(command), status)
     }
 
     /// What a supervisor (or the operator) holds of controller `ctrl`: the

@@ -16,6 +16,7 @@
 //! | [`exec`] | [`Controller`], [`Executive`] (the main program), [`Heartbeat`], pause/step/go through [`ExecutiveHandle`] |
 //! | `clock` | the executive's per-controller timing from the TSC (`quanta`), falling back to the OS clock |
 //! | [`math`] | the float built-in functions of the language (`sqrt`, `min`, …), shared by generated code and the interpreter |
+//! | [`builtin`] | the built-in statuses and error codes as typed enums, and the name lookups generated controllers share |
 //! | [`operator`] | [`Operator`]: command a root controller, read status |
 //! | [`trace`] | optional trace of every controller's cycle: JSON lines, or MCAP (feature `mcap`) |
 //! | [`schema`] | [`Schema`]: a stable hash of a buffer type's structure |
@@ -188,6 +189,7 @@
 pub mod acl;
 #[cfg(feature = "zenoh")]
 pub mod bridge;
+pub mod builtin;
 mod clock;
 pub mod driver;
 pub mod epoch;

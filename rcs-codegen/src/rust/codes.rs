@@ -2,6 +2,8 @@
 //! values — the `status` and `error` modules of constants and the typed
 //! `Status` and `Error` enums with their conversions and names, the
 //! built-ins first. Part of the controller's module ([`super::controller`]).
+//! A controller with nothing but the built-ins re-exports the runtime's
+//! (`rcs_runtime::builtin`).
 
 use super::controller::docs;
 use super::names::Names;
@@ -9,8 +11,19 @@ use proc_macro2::TokenStream;
 use quote::quote;
 use rcs_dsl::ir::Controller;
 
+/// NOT_READY, EXECUTING, DONE, ERROR: the statuses every controller has
+/// before its own.
+const BUILT_IN_STATUSES: usize = 4;
+
 /// The status and error items of controller `c` (index `ci`, named `name`).
 pub(super) fn codes(names: &Names, ci: usize, c: &Controller, name: &str) -> TokenStream {
+    // Only the built-ins: the runtime's copies, the same names and
+    // methods, compiled once for every such controller (issue 30).
+    if c.statuses.len() == BUILT_IN_STATUSES && c.errors.is_empty() && !c.can_refuse() {
+        return quote! {
+            pub use rt::builtin::{error, status, Error, Status};
+        };
+    }
     let n = &names.ctrls[ci];
     let status_consts = c.statuses.iter().enumerate().map(|(i, s)| {
         let id = &n.status_consts[i];

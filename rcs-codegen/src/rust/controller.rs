@@ -226,23 +226,35 @@ pub(crate) fn module(
         }
     });
 
-    // ---- verb and state names
-    let verb_ids: Vec<u16> = (0..c.commands.len() as u16).collect();
+    // ---- verb and state names: tables, looked up by one runtime
+    // function for every controller (issue 30)
     let verb_names: Vec<&str> = c.commands.iter().map(|k| k.name.as_str()).collect();
-    let state_arms = c.commands.iter().enumerate().filter_map(|(i, k)| {
-        let pid = k.plan?;
-        let ty = &n.plans[pid.index()].state_ty;
-        let i = i as u16;
-        Some(quote!(#i => match #ty::from_raw(state) { Some(s) => Some(s.name()), None => None }))
+    let plan_state_names = c.commands.iter().map(|k| {
+        let states = k
+            .plan
+            .map(|pid| {
+                c.plans[pid.index()]
+                    .states
+                    .iter()
+                    .map(|s| s.name.as_str())
+                    .collect()
+            })
+            .unwrap_or_else(Vec::new);
+        quote!(&[#(#states),*])
     });
+    let verbs = proc_macro2::Literal::usize_unsuffixed(verb_count);
     let names_fns = quote! {
+        /// Each verb's name, by verb id.
+        const VERB_NAMES: [&str; #verbs] = [#(#verb_names),*];
+        /// Each verb's plan's state names, by verb id and state id.
+        const STATE_NAMES: [&[&str]; #verbs] = [#(#plan_state_names),*];
         /// The name of a verb of this controller's, as written in the plans.
         pub const fn verb_name(verb: rt::VerbId) -> Option<&'static str> {
-            match verb { #(#verb_ids => Some(#verb_names),)* _ => None }
+            rt::builtin::name_at(&VERB_NAMES, verb)
         }
         /// The name of a state of a verb's plan, as written in the plans.
         pub const fn state_name(verb: rt::VerbId, state: rt::StateId) -> Option<&'static str> {
-            match verb { #(#state_arms,)* _ => None }
+            rt::builtin::state_name_at(&STATE_NAMES, verb, state)
         }
     };
 
@@ -530,6 +542,24 @@ pub(crate) fn module(
     } else {
         quote!()
     };
+    let reads_record = record(
+        " The Global Memory buffers this controller reads, as copied in this cycle.",
+        quote!(Reads),
+        quote!(#(#read_docs pub #read_fields: #read_tys),*),
+        read_fields.is_empty(),
+    );
+    let writes_record = record(
+        " The Global Memory buffers this controller alone writes.",
+        quote!(Writes),
+        quote!(#(#write_docs pub #write_fields: #write_tys),*),
+        write_fields.is_empty(),
+    );
+    let subs_record = record(
+        " The subordinates' statuses, seen through the handshake.",
+        quote!(Subs),
+        quote!(#(pub #sub_fields: rt::SubordinateView),*),
+        sub_fields.is_empty(),
+    );
     quote! {
         #mod_docs
         pub mod #module {
@@ -549,17 +579,11 @@ pub(crate) fn module(
             pub trait Hooks: Send { #(#hook_fns)* }
             #unit_hooks
 
-            /// The Global Memory buffers this controller reads, as copied in this cycle.
-            #[derive(Clone, Copy, Debug, Default, PartialEq)]
-            pub struct Reads { #(#read_docs pub #read_fields: #read_tys),* }
+            #reads_record
 
-            /// The Global Memory buffers this controller alone writes.
-            #[derive(Clone, Copy, Debug, Default, PartialEq)]
-            pub struct Writes { #(#write_docs pub #write_fields: #write_tys),* }
+            #writes_record
 
-            /// The subordinates' statuses, seen through the handshake.
-            #[derive(Clone, Copy, Debug, Default, PartialEq)]
-            pub struct Subs { #(pub #sub_fields: rt::SubordinateView),* }
+            #subs_record
 
             /// The controller's own world-model variables; they persist across cycles.
             #[derive(Clone, Copy, Debug, #vars_derive PartialEq)]
@@ -709,6 +733,24 @@ pub(crate) fn module(
             }
 
             #extra
+        }
+    }
+}
+
+/// A record of the controller's data (`Reads`, `Writes`, `Subs`): a struct
+/// with the usual derives, or, with no fields, the runtime's one empty
+/// record (issue 30: five derived impls less per controller).
+fn record(doc: &str, name: TokenStream, fields: TokenStream, empty: bool) -> TokenStream {
+    if empty {
+        quote! {
+            #[doc = #doc]
+            pub type #name = rt::builtin::NoFields;
+        }
+    } else {
+        quote! {
+            #[doc = #doc]
+            #[derive(Clone, Copy, Debug, Default, PartialEq)]
+            pub struct #name { #fields }
         }
     }
 }

@@ -9,17 +9,13 @@ use super::controller::docs;
 use super::names::Names;
 use proc_macro2::TokenStream;
 use quote::quote;
-use rcs_dsl::ir::Controller;
-
-/// NOT_READY, EXECUTING, DONE, ERROR: the statuses every controller has
-/// before its own.
-const BUILT_IN_STATUSES: usize = 4;
+use rcs_dsl::ir::{Controller, StatusId};
 
 /// The status and error items of controller `c` (index `ci`, named `name`).
 pub(super) fn codes(names: &Names, ci: usize, c: &Controller, name: &str) -> TokenStream {
     // Only the built-ins: the runtime's copies, the same names and
     // methods, compiled once for every such controller (issue 30).
-    if c.statuses.len() == BUILT_IN_STATUSES && c.errors.is_empty() && !c.can_refuse() {
+    if c.statuses.len() == StatusId::BUILTIN.len() && c.errors.is_empty() && !c.can_refuse() {
         return quote! {
             pub use rt::builtin::{error, status, Error, Status};
         };

@@ -104,7 +104,7 @@ fn home_of(scenario: &Path) -> Option<PathBuf> {
 
 /// The scenario files of a plan set's own `scenarios/` folder, sorted
 /// (what `rcsc test` runs for it when none are named).
-pub fn own_scenarios(set: &PlanSet) -> Result<Vec<PathBuf>, String> {
+fn own_scenarios(set: &PlanSet) -> Result<Vec<PathBuf>, String> {
     scenarios_in(&set_folder(set).join("scenarios"))
 }
 
@@ -166,7 +166,7 @@ pub fn assign(sets: &[PlanSet], named: &[PathBuf]) -> Result<Vec<Vec<PathBuf>>, 
     }
     for (i, list) in per_set.iter_mut().enumerate() {
         if list.is_empty() && named.is_empty() {
-            *list = scenarios_in(&folders[i].join("scenarios"))?;
+            *list = own_scenarios(&sets[i])?;
         }
     }
     Ok(per_set)
